@@ -1,0 +1,163 @@
+//! raybench-accel: the one trait every structure implements, and what it reports.
+//!
+//! Small and stable on purpose: every structure crate and the harness depend on it.
+//! * [`Accel`]: build, closest hit, any hit, the same two with [`Counters`], stats, memory.
+//! * [`BruteForce`]: the O(N) oracle every structure is checked against.
+//! * [`compare`]: the validation classes of ARCHITECTURE.md, deciding whether two answers agree.
+#![forbid(unsafe_code)]
+
+mod brute;
+pub mod compare;
+mod counters;
+
+pub use brute::{BruteForce, BruteForceParams};
+pub use counters::{CounterSink, Counters, NoCount};
+pub use raybench_geom as geom;
+
+use raybench_geom::{Ray, TriangleMesh};
+use serde::{Deserialize, Serialize};
+use std::any::Any;
+use std::collections::BTreeMap;
+use std::fmt::Debug;
+use std::sync::Arc;
+
+/// The closest (or any) hit of a ray. `prim` indexes the mesh the structure was built from, in
+/// its original order, whatever order the structure keeps triangles in internally.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Hit {
+    pub t: f32,
+    pub prim: u32,
+    /// Barycentric weight of the triangle's second vertex (Embree's `u`).
+    pub u: f32,
+    /// Barycentric weight of the triangle's third vertex (Embree's `v`).
+    pub v: f32,
+}
+
+/// Shape of the built structure, for reports. The SAH cost uses the shared constants
+/// ([`SAH_TRAVERSAL_COST`], [`SAH_INTERSECTION_COST`]) so structures are comparable.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BuildStats {
+    pub nodes: u64,
+    pub leaves: u64,
+    pub max_depth: u32,
+    /// Primitive references stored in leaves or cells (duplicates counted).
+    pub refs: u64,
+    /// SAH cost of the whole structure, where the structure has one.
+    pub sah_cost: Option<f64>,
+    /// Structure-specific figures (e.g. empty leaves, Embree's commit-only time).
+    pub extra: BTreeMap<String, f64>,
+}
+
+/// SAH cost of stepping through one node, relative to [`SAH_INTERSECTION_COST`].
+pub const SAH_TRAVERSAL_COST: f64 = 1.0;
+/// SAH cost of one ray–triangle test.
+pub const SAH_INTERSECTION_COST: f64 = 1.0;
+
+/// Bytes a structure holds, by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Memory {
+    pub nodes: u64,
+    pub indices: u64,
+    /// Copies of triangle data (precomputed edges, reordered vertices).
+    pub primitives: u64,
+}
+
+impl Memory {
+    pub fn total(&self) -> u64 {
+        self.nodes + self.indices + self.primitives
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    #[error(
+        "scene too large: the build would need about {needed_bytes} bytes, limit {limit_bytes}"
+    )]
+    TooLarge { needed_bytes: u64, limit_bytes: u64 },
+    #[error("unsupported input: {0}")]
+    Unsupported(String),
+    #[error("backend error: {0}")]
+    Backend(String),
+}
+
+/// Rays converted into a structure's own layout, outside any timed region (see
+/// [`Accel::prepare_rays`]). `Native` means "trace the `&[Ray]` as they are".
+#[derive(Debug)]
+pub enum PreparedRays {
+    Native,
+    Foreign(Box<dyn Any + Send + Sync>),
+}
+
+/// An acceleration structure over one triangle mesh.
+///
+/// Closest hit and any hit both accept a hit at `t` only when `t_min < t <= t_max`.
+/// Implementations run one traversal loop for all four queries, generic over "any hit" and a
+/// counter sink whose non-counting form ([`NoCount`]) is zero-sized.
+pub trait Accel: Send + Sync {
+    /// Named knobs; written into every report.
+    type Params: Default + Clone + Debug + Serialize
+    where
+        Self: Sized;
+
+    fn build(mesh: Arc<TriangleMesh>, params: &Self::Params) -> Result<Self, BuildError>
+    where
+        Self: Sized;
+
+    /// Registered name, e.g. `bvh-binned-sah`, `embree-medium`.
+    fn name(&self) -> &str;
+
+    /// Closest hit: the timed path.
+    fn intersect(&self, ray: &Ray) -> Option<Hit>;
+    /// Any hit: the timed path.
+    fn occluded(&self, ray: &Ray) -> bool;
+    /// The same walk as [`Accel::intersect`], counting its work.
+    fn intersect_counted(&self, ray: &Ray, c: &mut Counters) -> Option<Hit>;
+    fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool;
+
+    fn build_stats(&self) -> BuildStats;
+    fn memory(&self) -> Memory;
+
+    /// False for structures whose work cannot be counted (Embree): reports show no counters.
+    fn has_counters(&self) -> bool {
+        true
+    }
+
+    /// Converts rays into this structure's layout and checks them; called outside timing.
+    fn prepare_rays(&self, _rays: &[Ray]) -> Result<PreparedRays, raybench_geom::RayError> {
+        Ok(PreparedRays::Native)
+    }
+
+    /// Traces `rays[first..first + out.len()]` (closest hit): the timed batch path.
+    fn intersect_prepared(
+        &self,
+        rays: &[Ray],
+        _prepared: &PreparedRays,
+        first: usize,
+        out: &mut [Option<Hit>],
+    ) {
+        for (o, ray) in out.iter_mut().zip(&rays[first..]) {
+            *o = self.intersect(ray);
+        }
+    }
+
+    /// Any-hit counterpart of [`Accel::intersect_prepared`].
+    fn occluded_prepared(
+        &self,
+        rays: &[Ray],
+        _prepared: &PreparedRays,
+        first: usize,
+        out: &mut [bool],
+    ) {
+        for (o, ray) in out.iter_mut().zip(&rays[first..]) {
+            *o = self.occluded(ray);
+        }
+    }
+}
+
+/// Builds a structure and returns it as a trait object, with its parameters as JSON for reports.
+pub fn build_dyn<A: Accel + 'static>(
+    mesh: Arc<TriangleMesh>,
+    params: &A::Params,
+) -> Result<Box<dyn Accel>, BuildError> {
+    Ok(Box::new(A::build(mesh, params)?))
+}

@@ -1,0 +1,37 @@
+//! raybench-geom: the geometric vocabulary shared by every structure and by the Embree binding.
+//!
+//! * [`Ray`]: origin, direction and the half-open segment `(t_min, t_max]`, with a reciprocal
+//!   direction that stays correct for `±0` components.
+//! * [`Aabb`]: axis-aligned box with a slab test that never produces NaN for axis-parallel rays
+//!   and hits flat (zero-thickness) boxes.
+//! * [`Triangle`] and [`TriangleMesh`], with the two ray–triangle tests raybench uses:
+//!   Möller–Trumbore in the form Embree's fast mode uses, and the watertight test of
+//!   Woop, Benthin and Wald (2013).
+//!
+//! No `unsafe`, no acceleration structures.
+#![forbid(unsafe_code)]
+
+mod aabb;
+mod mesh;
+mod ray;
+mod triangle;
+
+pub use aabb::Aabb;
+pub use glam::{DVec3, Vec3};
+pub use mesh::{MeshError, RemovedTriangles, TriangleMesh};
+pub use ray::{EMBREE_LARGE, Ray, RayError};
+pub use triangle::{TriHit, Triangle, TriangleTest};
+
+/// Largest finite value that still compares correctly: `max` of two floats, ignoring a NaN in
+/// `candidate`. Written as a comparison so it compiles to one `maxss` (NaN in `candidate` keeps
+/// `acc`); used by the slab test where `0 * inf` may produce NaN.
+#[inline(always)]
+pub fn max_keep(acc: f32, candidate: f32) -> f32 {
+    if candidate > acc { candidate } else { acc }
+}
+
+/// `min` counterpart of [`max_keep`]: a NaN `candidate` leaves `acc` unchanged.
+#[inline(always)]
+pub fn min_keep(acc: f32, candidate: f32) -> f32 {
+    if candidate < acc { candidate } else { acc }
+}
