@@ -8,7 +8,7 @@
 //! anything else is a `Mismatch` — a real bug in one of the two.
 
 use crate::Hit;
-use raybench_geom::{Ray, TriangleMesh};
+use raybench_geom::{Ray, TriangleMesh, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// How two answers relate.
@@ -50,14 +50,23 @@ impl Default for Tolerance {
 }
 
 impl Tolerance {
-    /// Largest acceptable |t_a - t_b| for a ray whose interesting points have magnitude `scale`.
-    pub fn t_tolerance(&self, ray: &Ray, t: f32, scale: f64) -> f64 {
+    /// Largest acceptable |t_a - t_b| for a hit on a triangle with (unnormalised) `normal`,
+    /// when the points involved have magnitude up to `scale`. A positional error `e` moves the
+    /// hit along the ray by `e / |n̂·d|` in t, so grazing rays get a proportionally wider
+    /// window (reliability.md: Möller–Trumbore loses accuracy as `den` goes to 0).
+    pub fn t_tolerance(&self, ray: &Ray, t: f32, scale: f64, normal: Vec3) -> f64 {
         let ulp = ulp(t.abs()) as f64 * self.ulps as f64;
-        let dir_len = ray.dir().as_dvec3().length();
-        let positional = if dir_len > 0.0 {
-            self.position_eps * scale / dir_len
+        let d = ray.dir().as_dvec3();
+        let n = normal.as_dvec3();
+        let along_normal = if n.length_squared() > 0.0 {
+            n.normalize().dot(d).abs()
         } else {
-            0.0
+            d.length()
+        };
+        let positional = if along_normal > 0.0 {
+            self.position_eps * scale / along_normal
+        } else {
+            f64::INFINITY
         };
         ulp.max(positional)
     }
@@ -90,7 +99,13 @@ pub fn classify(
         (Some(a), None) | (None, Some(a)) => dispute(mesh, ray, a.prim, tol),
         (Some(a), Some(b)) => {
             let scale = hit_scale(ray, a.t).max(hit_scale(ray, b.t));
-            let close = ((a.t - b.t).abs() as f64) <= tol.t_tolerance(ray, a.t.max(b.t), scale);
+            let t = a.t.max(b.t);
+            let window = |prim: u32| match prim_normal(mesh, prim) {
+                Some(n) => tol.t_tolerance(ray, t, scale, n),
+                None => 0.0,
+            };
+            // The more grazing of the two triangles decides how uncertain t is.
+            let close = ((a.t - b.t).abs() as f64) <= window(a.prim).max(window(b.prim));
             match (a.prim == b.prim, close) {
                 (true, _) if a.t.to_bits() == b.t.to_bits() => Verdict::Exact,
                 (true, true) => Verdict::WithinTolerance,
@@ -128,6 +143,10 @@ pub fn classify_occlusion(
     }
 }
 
+fn prim_normal(mesh: &TriangleMesh, prim: u32) -> Option<Vec3> {
+    ((prim as usize) < mesh.len()).then(|| mesh.triangle(prim as usize).geometric_normal())
+}
+
 /// One side hit `prim` and the other did not see it: decide whether that is excusable.
 fn dispute(mesh: &TriangleMesh, ray: &Ray, prim: u32, tol: &Tolerance) -> Verdict {
     if prim as usize >= mesh.len() {
@@ -137,7 +156,7 @@ fn dispute(mesh: &TriangleMesh, ray: &Ray, prim: u32, tol: &Tolerance) -> Verdic
     let Some(x) = tri.plane_crossing_f64(ray) else {
         return Verdict::EdgeAmbiguous; // parallel to the plane: grazing
     };
-    let t_tol = tol.t_tolerance(ray, x.t as f32, x.scale);
+    let t_tol = tol.t_tolerance(ray, x.t as f32, x.scale, tri.geometric_normal());
     let near_t_min = (x.t - ray.t_min() as f64).abs() <= t_tol;
     let near_t_max = ray.t_max().is_finite() && (x.t - ray.t_max() as f64).abs() <= t_tol;
     if near_t_min || near_t_max {
@@ -237,6 +256,24 @@ mod tests {
         assert_eq!(
             classify(&m, &down(0.5, 0.5), hit(1.0, 0), hit(1.0, 1), &tol),
             Verdict::Tie
+        );
+    }
+
+    #[test]
+    fn grazing_rays_get_a_wider_t_window() {
+        let m = quad();
+        let tol = Tolerance::default();
+        // Nearly parallel to the plane: |n̂·d| = 1e-3, so a 1e-4 shift in t is within the
+        // positional uncertainty; head-on, the same shift is a mismatch.
+        let grazing = Ray::infinite(Vec3::new(-0.3, 0.2, 1e-3), Vec3::new(1.0, 0.0, -1e-3));
+        assert_eq!(
+            classify(&m, &grazing, hit(1.0, 0), hit(1.0001, 0), &tol),
+            Verdict::WithinTolerance
+        );
+        let head_on = down(0.7, 0.2);
+        assert_eq!(
+            classify(&m, &head_on, hit(1.0, 0), hit(1.0001, 0), &tol),
+            Verdict::Mismatch
         );
     }
 

@@ -1,0 +1,185 @@
+//! [`EmbreeParams`]: the Embree knobs a report records, and the device config they imply.
+
+use raybench_embree_sys::RTCBuildQuality;
+use serde::{Deserialize, Serialize};
+
+/// Embree's BVH build quality (`rtcSetSceneBuildQuality`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Quality {
+    /// Fast, refit-friendly build (Embree's "dynamic" branch).
+    Low,
+    /// Embree's default: binned SAH.
+    #[default]
+    Medium,
+    /// Adds spatial splits: slower build, faster traversal.
+    High,
+}
+
+impl Quality {
+    pub fn name(self) -> &'static str {
+        match self {
+            Quality::Low => "low",
+            Quality::Medium => "medium",
+            Quality::High => "high",
+        }
+    }
+
+    pub(crate) fn to_rtc(self) -> RTCBuildQuality {
+        match self {
+            Quality::Low => RTCBuildQuality::RTC_BUILD_QUALITY_LOW,
+            Quality::Medium => RTCBuildQuality::RTC_BUILD_QUALITY_MEDIUM,
+            Quality::High => RTCBuildQuality::RTC_BUILD_QUALITY_HIGH,
+        }
+    }
+}
+
+/// How an Embree scene is built. The default is Embree's own: medium quality, fast mode.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct EmbreeParams {
+    pub quality: Quality,
+    /// `RTC_SCENE_FLAG_ROBUST`: conservative traversal and Plücker triangle test, no cracks
+    /// along shared edges, inclusive at `t_min` (reliability.md §0.3).
+    pub robust: bool,
+    /// Embree worker threads; 0 = all cores. Goes into the device config as `threads=N`.
+    pub threads: usize,
+    /// Pins Embree's ISA (`isa=avx2`, …); `None` lets Embree pick the best the CPU has.
+    pub isa: Option<String>,
+}
+
+impl EmbreeParams {
+    pub fn low() -> EmbreeParams {
+        EmbreeParams {
+            quality: Quality::Low,
+            ..EmbreeParams::default()
+        }
+    }
+
+    pub fn medium() -> EmbreeParams {
+        EmbreeParams::default()
+    }
+
+    pub fn high() -> EmbreeParams {
+        EmbreeParams {
+            quality: Quality::High,
+            ..EmbreeParams::default()
+        }
+    }
+
+    /// Medium quality with `RTC_SCENE_FLAG_ROBUST`.
+    pub fn robust() -> EmbreeParams {
+        EmbreeParams {
+            robust: true,
+            ..EmbreeParams::default()
+        }
+    }
+
+    /// The device config: `threads=N`, thread start-up at device creation rather than in the
+    /// first timed build (`start_threads=1`), no pinning (`set_affinity=0`), and `isa=` when
+    /// pinned.
+    pub fn config_string(&self) -> String {
+        let mut config = format!("threads={},start_threads=1,set_affinity=0", self.threads);
+        if let Some(isa) = &self.isa {
+            config.push_str(",isa=");
+            config.push_str(isa);
+        }
+        config
+    }
+
+    /// Registered name: `embree-<quality>`, with robust medium as `embree-robust` and other
+    /// robust qualities as `embree-<quality>-robust`.
+    pub fn name(&self) -> String {
+        match (self.quality, self.robust) {
+            (q, false) => format!("embree-{}", q.name()),
+            (Quality::Medium, true) => "embree-robust".to_string(),
+            (q, true) => format!("embree-{}-robust", q.name()),
+        }
+    }
+
+    /// Refuses an `isa` Embree does not know: Embree would silently run SSE2 instead, and a
+    /// comma could smuggle other options into the config string.
+    pub(crate) fn check_isa(&self) -> Result<(), String> {
+        match &self.isa {
+            Some(isa) if !crate::info::is_known_isa(isa) => Err(format!(
+                "isa {isa:?} is not one of Embree's: sse2, sse4.2, avx, avx2, avx512"
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_names_and_config() {
+        let names: Vec<String> = [
+            EmbreeParams::low(),
+            EmbreeParams::medium(),
+            EmbreeParams::high(),
+            EmbreeParams::robust(),
+        ]
+        .iter()
+        .map(EmbreeParams::name)
+        .collect();
+        assert_eq!(
+            names,
+            [
+                "embree-low",
+                "embree-medium",
+                "embree-high",
+                "embree-robust"
+            ]
+        );
+        let high_robust = EmbreeParams {
+            robust: true,
+            ..EmbreeParams::high()
+        };
+        assert_eq!(high_robust.name(), "embree-high-robust");
+        let pinned = EmbreeParams {
+            threads: 2,
+            isa: Some("avx2".into()),
+            ..EmbreeParams::default()
+        };
+        assert_eq!(
+            pinned.config_string(),
+            "threads=2,start_threads=1,set_affinity=0,isa=avx2"
+        );
+        assert_eq!(
+            EmbreeParams::default().config_string(),
+            "threads=0,start_threads=1,set_affinity=0"
+        );
+    }
+
+    #[test]
+    fn serialises_with_lowercase_quality() {
+        let json = serde_json::to_string(&EmbreeParams::robust()).unwrap();
+        assert_eq!(
+            json,
+            r#"{"quality":"medium","robust":true,"threads":0,"isa":null}"#
+        );
+        let back: EmbreeParams = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, EmbreeParams::robust());
+    }
+
+    #[test]
+    fn isa_cannot_inject_options() {
+        let bad = EmbreeParams {
+            isa: Some("avx2,threads=64".into()),
+            ..EmbreeParams::default()
+        };
+        assert!(bad.check_isa().is_err());
+        let unknown = EmbreeParams {
+            isa: Some("pentium".into()),
+            ..EmbreeParams::default()
+        };
+        assert!(unknown.check_isa().is_err());
+        assert!(EmbreeParams::default().check_isa().is_ok());
+        let avx2 = EmbreeParams {
+            isa: Some("AVX2".into()),
+            ..EmbreeParams::default()
+        };
+        assert!(avx2.check_isa().is_ok());
+    }
+}

@@ -1,0 +1,34 @@
+//! The shared conformance suite (raybench-testkit) for every Embree preset: seeded scenes and
+//! edge cases against brute force, zero mismatches.
+
+use raybench_embree::{EmbreeParams, EmbreeScene};
+use raybench_testkit::{conformance, no_validation};
+
+fn check(params: EmbreeParams) {
+    let counts = conformance::<EmbreeScene>(&params, &no_validation);
+    assert_eq!(counts.mismatch, 0);
+    assert!(
+        counts.exact + counts.within_tolerance > 10_000,
+        "the suite must exercise hits: {counts:?}"
+    );
+}
+
+#[test]
+fn embree_low_conforms() {
+    check(EmbreeParams::low());
+}
+
+#[test]
+fn embree_medium_conforms() {
+    check(EmbreeParams::medium());
+}
+
+#[test]
+fn embree_high_conforms() {
+    check(EmbreeParams::high());
+}
+
+#[test]
+fn embree_robust_conforms() {
+    check(EmbreeParams::robust());
+}

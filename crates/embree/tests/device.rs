@@ -1,0 +1,128 @@
+//! The device: what it reports about Embree, its memory accounting, config errors.
+
+mod common;
+
+use common::random_triangles;
+use raybench_accel::Accel;
+use raybench_embree::{
+    Device, EmbreeError, EmbreeInfo, EmbreeParams, EmbreeScene, ISA_FROM_CONFIG, ISA_INFERRED,
+    infer_isa,
+};
+use std::sync::Arc;
+
+#[test]
+fn info_reports_debian_embree() {
+    let device = Device::new("threads=1,start_threads=1,set_affinity=0").unwrap();
+    let info = device.info();
+    println!("{info:#?}");
+    assert_eq!(info.version, "3.13.5");
+    assert!(info.ray_mask_supported, "Debian builds with ray masks");
+    assert!(!info.ignore_invalid_rays, "Debian aborts on invalid rays");
+    assert!(!info.backface_culling);
+    assert_eq!(info.tasking_system, "TBB");
+    assert_eq!(info.config, "threads=1,start_threads=1,set_affinity=0");
+    assert_eq!(
+        (info.isa.as_str(), info.isa_source.as_str()),
+        (infer_isa(), ISA_INFERRED)
+    );
+    let json = serde_json::to_string(&info).unwrap();
+    assert_eq!(serde_json::from_str::<EmbreeInfo>(&json).unwrap(), info);
+}
+
+#[test]
+fn pinned_isa_is_reported_from_the_config() {
+    let params = EmbreeParams {
+        threads: 1,
+        isa: Some("sse2".into()),
+        ..EmbreeParams::default()
+    };
+    let device = Device::shared(&params.config_string()).unwrap();
+    let info = device.info();
+    assert_eq!(
+        (info.isa.as_str(), info.isa_source.as_str()),
+        ("SSE2", ISA_FROM_CONFIG)
+    );
+    // And the SSE2 kernels answer like the others on a simple case.
+    let mesh = random_triangles(0x5EED_0006, 100);
+    let embree = EmbreeScene::build(mesh.clone(), &params).unwrap();
+    let origin = raybench_geom::Vec3::new(0.5, 0.5, 3.0);
+    let ray = raybench_geom::Ray::infinite(origin, mesh.triangle(5).centroid() - origin);
+    assert!(embree.intersect(&ray).is_some());
+}
+
+#[test]
+fn unusable_isa_fails_the_build_cleanly() {
+    let params = EmbreeParams {
+        isa: Some("avx2,threads=64".into()),
+        ..EmbreeParams::default()
+    };
+    let err = EmbreeScene::build(random_triangles(1, 10), &params).unwrap_err();
+    assert!(err.to_string().contains("isa"), "{err}");
+    let unknown = EmbreeParams {
+        isa: Some("pentium".into()),
+        ..EmbreeParams::default()
+    };
+    assert!(EmbreeScene::build(random_triangles(1, 10), &unknown).is_err());
+}
+
+/// Embree runs SSE2 for an ISA name it does not know, without any error (checked with
+/// `verbose=1`); the info says so instead of echoing the name.
+#[test]
+fn unknown_isa_name_is_reported_as_embrees_sse2_fallback() {
+    let device = Device::new("threads=1,isa=pentium").unwrap();
+    assert_eq!(device.info().isa, "SSE2");
+}
+
+#[test]
+fn bad_config_value_is_a_device_creation_error() {
+    let err = Device::new("threads=abc").unwrap_err();
+    assert!(
+        matches!(
+            err,
+            EmbreeError::DeviceCreation {
+                code: "RTC_ERROR_UNKNOWN",
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let err = EmbreeScene::build(
+        random_triangles(1, 10),
+        &EmbreeParams {
+            threads: 1,
+            ..EmbreeParams::default()
+        },
+    );
+    assert!(err.is_ok(), "a good config still works afterwards");
+}
+
+/// The memory monitor sees the BVH: a scene's `memory()` grows with the mesh, and the
+/// device's running count returns to where it was once the scenes are gone.
+#[test]
+fn memory_monitor_accounts_for_each_build() {
+    let device = Arc::new(Device::new("threads=1,start_threads=1,set_affinity=0").unwrap());
+    let baseline = device.allocated_bytes();
+    let build = |n: usize| {
+        let mesh = random_triangles(0x5EED_0007, n);
+        EmbreeScene::build_on(device.clone(), mesh, &EmbreeParams::medium()).unwrap()
+    };
+    let small = build(1_000);
+    let large = build(20_000);
+    let (s, l) = (small.memory().nodes, large.memory().nodes);
+    println!(
+        "baseline {baseline} B, BVH 1k tris {s} B, 20k tris {l} B, buffers {} B, now {} B",
+        large.build_stats().extra["buffer_bytes"],
+        device.allocated_bytes()
+    );
+    assert!(
+        s > 0 && l > 10 * s,
+        "BVH memory must grow with the mesh: {s} vs {l}"
+    );
+    drop((small, large));
+    let after = device.allocated_bytes();
+    println!("after dropping both scenes: {after} B");
+    assert!(
+        after <= baseline + (l as i64) / 10,
+        "freed memory is counted back"
+    );
+}

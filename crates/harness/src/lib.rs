@@ -1,0 +1,11 @@
+//! raybench-harness: runs suites of scenes × structures × workloads, times builds and traces,
+//! validates every ray against a reference, and writes `report.json`.
+#![forbid(unsafe_code)]
+
+pub mod env;
+pub mod measure;
+pub mod registry;
+pub mod report;
+pub mod run;
+pub mod summary;
+pub mod validate;

@@ -1,0 +1,189 @@
+//! Timing: builds and trace passes, medians of repeated runs after a warm-up.
+//!
+//! Nothing here counts or checks inside a timed region: the trace passes call the structures'
+//! prepared batch path (rays already in each structure's layout), and the counting pass is a
+//! separate, untimed, single-threaded walk.
+
+use crate::registry::{BuildContext, Built, StructureEntry};
+use crate::report::{Throughput, Timing};
+use raybench_accel::{Accel, BuildError, Counters, Hit, PreparedRays};
+use raybench_geom::{Ray, TriangleMesh};
+use rayon::prelude::*;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Rays per rayon task when tracing with several threads: large enough that scheduling costs
+/// are noise (~1 µs per task vs ≥ 25 µs of tracing), small enough to balance 2 cores.
+const CHUNK: usize = 256;
+
+/// A warm-up pass longer than this is measured once more, not `trace_runs` times, so a brute
+/// force pass over a large scene cannot hold a run for minutes. The report records the runs.
+const LONG_PASS: Duration = Duration::from_secs(5);
+
+/// Median, minimum and maximum of samples (the median of an even count is the mean of the
+/// middle two).
+pub fn median_min_max(samples: &[f64]) -> (f64, f64, f64) {
+    assert!(!samples.is_empty(), "no samples");
+    let mut s = samples.to_vec();
+    s.sort_by(f64::total_cmp);
+    let mid = s.len() / 2;
+    let median = if s.len() % 2 == 0 {
+        (s[mid - 1] + s[mid]) / 2.0
+    } else {
+        s[mid]
+    };
+    (median, s[0], s[s.len() - 1])
+}
+
+/// One warm-up build (which also creates shared state such as Embree's device), then `runs`
+/// timed builds. Returns the last build. Each build's predecessor is dropped outside the
+/// timed window.
+pub fn time_builds(
+    entry: &StructureEntry,
+    mesh: &Arc<TriangleMesh>,
+    ctx: &BuildContext,
+    runs: usize,
+) -> Result<(Built, Timing), BuildError> {
+    let mut built = entry.build(mesh.clone(), ctx)?;
+    let mut ms = Vec::with_capacity(runs);
+    for _ in 0..runs.max(1) {
+        let start = Instant::now();
+        let next = entry.build(mesh.clone(), ctx)?;
+        ms.push(start.elapsed().as_secs_f64() * 1e3);
+        built = next;
+    }
+    let (median_ms, min_ms, max_ms) = median_min_max(&ms);
+    Ok((
+        built,
+        Timing {
+            median_ms,
+            min_ms,
+            max_ms,
+            runs: ms.len(),
+        },
+    ))
+}
+
+/// Answers of one structure to one workload.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Answers {
+    Closest(Vec<Option<Hit>>),
+    Any(Vec<bool>),
+}
+
+impl Answers {
+    pub fn new(any_hit: bool, n: usize) -> Answers {
+        if any_hit {
+            Answers::Any(vec![false; n])
+        } else {
+            Answers::Closest(vec![None; n])
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        match self {
+            Answers::Closest(h) => h.len(),
+            Answers::Any(o) => o.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    pub fn closest(&self) -> Option<&[Option<Hit>]> {
+        match self {
+            Answers::Closest(h) => Some(h),
+            Answers::Any(_) => None,
+        }
+    }
+}
+
+/// One pass over every ray through the structure's prepared batch path. Must run inside the
+/// run's thread pool; with one thread it is a plain loop on that worker.
+pub fn trace_pass(
+    accel: &dyn Accel,
+    rays: &[Ray],
+    prepared: &PreparedRays,
+    threads: usize,
+    out: &mut Answers,
+) -> Duration {
+    let start = Instant::now();
+    match out {
+        Answers::Closest(hits) if threads <= 1 => accel.intersect_prepared(rays, prepared, 0, hits),
+        Answers::Any(occ) if threads <= 1 => accel.occluded_prepared(rays, prepared, 0, occ),
+        Answers::Closest(hits) => hits
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(i, chunk)| accel.intersect_prepared(rays, prepared, i * CHUNK, chunk)),
+        Answers::Any(occ) => occ
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(i, chunk)| accel.occluded_prepared(rays, prepared, i * CHUNK, chunk)),
+    }
+    start.elapsed()
+}
+
+/// A warm-up pass (whose answers are returned for validation), then timed passes.
+pub fn time_traces(
+    accel: &dyn Accel,
+    rays: &[Ray],
+    prepared: &PreparedRays,
+    any_hit: bool,
+    threads: usize,
+    runs: usize,
+) -> (Answers, Throughput) {
+    let mut answers = Answers::new(any_hit, rays.len());
+    let warm = trace_pass(accel, rays, prepared, threads, &mut answers);
+    let runs = if warm > LONG_PASS { 1 } else { runs.max(1) };
+    let mut scratch = Answers::new(any_hit, rays.len());
+    let mrays: Vec<f64> = (0..runs)
+        .map(|_| {
+            rays.len() as f64
+                / trace_pass(accel, rays, prepared, threads, &mut scratch)
+                    .as_secs_f64()
+                    .max(1e-9)
+                / 1e6
+        })
+        .collect();
+    let (median, min, max) = median_min_max(&mrays);
+    (
+        answers,
+        Throughput {
+            median,
+            min,
+            max,
+            runs,
+        },
+    )
+}
+
+/// The untimed counting walk, single-threaded so the counters are deterministic.
+pub fn count_pass(accel: &dyn Accel, rays: &[Ray], any_hit: bool) -> (Answers, Counters) {
+    let mut c = Counters::default();
+    let answers = if any_hit {
+        Answers::Any(
+            rays.iter()
+                .map(|r| accel.occluded_counted(r, &mut c))
+                .collect(),
+        )
+    } else {
+        Answers::Closest(
+            rays.iter()
+                .map(|r| accel.intersect_counted(r, &mut c))
+                .collect(),
+        )
+    };
+    (answers, c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median_min_max(&[3.0, 1.0, 2.0]), (2.0, 1.0, 3.0));
+        assert_eq!(median_min_max(&[4.0, 1.0, 2.0, 3.0]), (2.5, 1.0, 4.0));
+    }
+}

@@ -1,0 +1,150 @@
+//! The name → structure registry. Adding a structure to raybench means one `register` line here
+//! (see README, "Adding a structure").
+
+use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
+use raybench_embree::{EmbreeParams, EmbreeScene};
+use raybench_geom::{TriangleMesh, TriangleTest};
+use std::sync::Arc;
+
+/// What a build may depend on besides the mesh.
+#[derive(Clone, Copy, Debug)]
+pub struct BuildContext {
+    /// Worker threads of this run (Embree's device gets `threads=N`; our builders use the
+    /// rayon pool they run in).
+    pub threads: usize,
+}
+
+/// A built structure and its parameters, as written into the report.
+pub struct Built {
+    pub accel: Box<dyn Accel>,
+    pub params: serde_json::Value,
+}
+
+impl std::fmt::Debug for Built {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Built")
+            .field("accel", &self.accel.name())
+            .field("params", &self.params)
+            .finish()
+    }
+}
+
+type Builder = dyn Fn(Arc<TriangleMesh>, &BuildContext) -> Result<Built, BuildError> + Send + Sync;
+
+pub struct StructureEntry {
+    pub name: &'static str,
+    pub description: &'static str,
+    /// Suites skip the structure above this many triangles (it would take too long); naming the
+    /// structure explicitly with `--structures` always runs it.
+    pub suite_triangle_limit: Option<usize>,
+    builder: Box<Builder>,
+}
+
+impl std::fmt::Debug for StructureEntry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StructureEntry")
+            .field("name", &self.name)
+            .finish_non_exhaustive()
+    }
+}
+
+impl StructureEntry {
+    pub fn build(&self, mesh: Arc<TriangleMesh>, ctx: &BuildContext) -> Result<Built, BuildError> {
+        (self.builder)(mesh, ctx)
+    }
+}
+
+fn register<A: Accel + 'static>(
+    name: &'static str,
+    description: &'static str,
+    suite_triangle_limit: Option<usize>,
+    params: impl Fn(&BuildContext) -> A::Params + Send + Sync + 'static,
+) -> StructureEntry {
+    let builder = move |mesh: Arc<TriangleMesh>, ctx: &BuildContext| {
+        let p = params(ctx);
+        let params = serde_json::to_value(&p).map_err(|e| BuildError::Backend(e.to_string()))?;
+        Ok(Built {
+            accel: Box::new(A::build(mesh, &p)?),
+            params,
+        })
+    };
+    StructureEntry {
+        name,
+        description,
+        suite_triangle_limit,
+        builder: Box::new(builder),
+    }
+}
+
+fn embree(base: EmbreeParams) -> impl Fn(&BuildContext) -> EmbreeParams + Send + Sync {
+    move |ctx| EmbreeParams {
+        threads: ctx.threads,
+        ..base.clone()
+    }
+}
+
+/// Brute force tests every triangle: 20k triangles × 100k rays is already 2e9 tests per pass.
+const BRUTE_FORCE_SUITE_LIMIT: usize = 20_000;
+
+/// Every structure raybench knows, in the order reports list them.
+pub fn registry() -> Vec<StructureEntry> {
+    vec![
+        register::<BruteForce>(
+            "bruteforce",
+            "every triangle for every ray (Möller–Trumbore): the O(N) oracle",
+            Some(BRUTE_FORCE_SUITE_LIMIT),
+            |_| BruteForceParams {
+                triangle_test: TriangleTest::MollerTrumbore,
+            },
+        ),
+        register::<BruteForce>(
+            "bruteforce-watertight",
+            "every triangle for every ray (Woop–Benthin–Wald watertight test)",
+            Some(BRUTE_FORCE_SUITE_LIMIT),
+            |_| BruteForceParams {
+                triangle_test: TriangleTest::Watertight,
+            },
+        ),
+        register::<EmbreeScene>(
+            "embree-low",
+            "Embree 3 BVH, RTC_BUILD_QUALITY_LOW (fast build)",
+            None,
+            embree(EmbreeParams::low()),
+        ),
+        register::<EmbreeScene>(
+            "embree-medium",
+            "Embree 3 BVH, RTC_BUILD_QUALITY_MEDIUM (Embree's default; the reference)",
+            None,
+            embree(EmbreeParams::medium()),
+        ),
+        register::<EmbreeScene>(
+            "embree-high",
+            "Embree 3 BVH, RTC_BUILD_QUALITY_HIGH (spatial splits)",
+            None,
+            embree(EmbreeParams::high()),
+        ),
+        register::<EmbreeScene>(
+            "embree-robust",
+            "Embree 3 BVH, medium quality with RTC_SCENE_FLAG_ROBUST (watertight Plücker test)",
+            None,
+            embree(EmbreeParams::robust()),
+        ),
+    ]
+}
+
+/// Looks up names, keeping the registry order; unknown names are an error listing the known.
+pub fn select(names: &[String]) -> anyhow::Result<Vec<StructureEntry>> {
+    let all = registry();
+    let known: Vec<&str> = all.iter().map(|e| e.name).collect();
+    if let Some(bad) = names.iter().find(|n| !known.contains(&n.as_str())) {
+        anyhow::bail!("unknown structure '{bad}'; known: {}", known.join(", "));
+    }
+    Ok(all
+        .into_iter()
+        .filter(|e| names.iter().any(|n| n == e.name))
+        .collect())
+}
+
+pub fn find(name: &str) -> anyhow::Result<StructureEntry> {
+    Ok(select(&[name.to_string()])?.remove(0))
+}

@@ -1,0 +1,313 @@
+//! `report.json`: the data model, written atomically and read back with serde.
+//!
+//! Every float in the report is finite: a miss is an explicit `null` hit, never `t = inf`
+//! (serde_json writes non-finite floats as `null` and then cannot read them back), and exact
+//! ray and hit values are carried as hex bit patterns so a disputed ray can be replayed.
+
+use crate::env::Environment;
+use raybench_accel::compare::{Tolerance, VerdictCounts};
+use raybench_accel::{BuildStats, Counters, Hit, Memory};
+use raybench_geom::{Ray, RemovedTriangles};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Bumped whenever a field changes meaning or disappears.
+pub const SCHEMA_VERSION: u32 = 1;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Report {
+    pub schema_version: u32,
+    pub tool_version: String,
+    pub environment: Environment,
+    pub run: RunSettings,
+    pub scenes: Vec<SceneRecord>,
+    pub results: Vec<ResultEntry>,
+    /// Things the reader should know: skipped structures, absent optional scenes, …
+    pub notes: Vec<String>,
+    /// Scenes or structures that failed (the rest of the run went on).
+    pub errors: Vec<String>,
+}
+
+/// The knobs of the run itself.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunSettings {
+    pub suite: Option<String>,
+    pub seed: u64,
+    pub rays: usize,
+    pub threads: usize,
+    pub reference: String,
+    pub build_runs: usize,
+    pub trace_runs: usize,
+    pub tolerance: Tolerance,
+    pub structures: Vec<String>,
+    pub workloads: Vec<String>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SceneRecord {
+    pub name: String,
+    pub source: serde_json::Value,
+    pub triangles: TriangleCounts,
+    pub load_ms: f64,
+    pub loader_notes: Vec<String>,
+    pub view: serde_json::Value,
+    /// Workloads as generated for this scene (same rays for every structure).
+    pub workloads: Vec<WorkloadRecord>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct WorkloadRecord {
+    pub workload: String,
+    pub rays: usize,
+    pub any_hit: bool,
+    /// Primary image size, where the workload is an image.
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct TriangleCounts {
+    /// Triangles the loader or generator produced.
+    pub loaded: u64,
+    /// Removed before any structure saw them (what Embree would silently ignore).
+    pub removed: u64,
+    pub removed_by_reason: RemovedTriangles,
+    /// Triangles every structure traces (`loaded - removed`).
+    pub traced: u64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ResultEntry {
+    pub scene: String,
+    pub triangles: TriangleCounts,
+    pub structure: String,
+    pub params: serde_json::Value,
+    pub build: Timing,
+    /// Build median divided by the reference's build median in this run.
+    pub build_ratio_to_reference: Option<f64>,
+    pub memory_bytes: u64,
+    pub memory: Memory,
+    pub build_stats: BuildStats,
+    pub workloads: Vec<WorkloadResult>,
+}
+
+/// Wall-clock build time over `runs` builds after one warm-up build.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct Timing {
+    pub median_ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+    pub runs: usize,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct Throughput {
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+    pub runs: usize,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct WorkloadResult {
+    pub workload: String,
+    pub rays: usize,
+    pub any_hit: bool,
+    pub mrays_per_s: Throughput,
+    /// Median throughput divided by the reference's in this run (> 1: faster than reference).
+    pub speedup_vs_reference: Option<f64>,
+    /// `None` for structures that cannot count their work (Embree).
+    pub counters_per_ray: Option<CountersPerRay>,
+    pub counters_total: Option<Counters>,
+    pub validation: Validation,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct CountersPerRay {
+    pub nodes: f64,
+    pub leaves: f64,
+    pub prim_tests: f64,
+    pub cells: f64,
+    pub mailbox_skips: f64,
+}
+
+impl CountersPerRay {
+    pub fn from_total(c: &Counters, rays: usize) -> CountersPerRay {
+        let n = rays.max(1) as f64;
+        CountersPerRay {
+            nodes: c.nodes as f64 / n,
+            leaves: c.leaves as f64 / n,
+            prim_tests: c.prim_tests as f64 / n,
+            cells: c.cells as f64 / n,
+            mailbox_skips: c.mailbox_skips as f64 / n,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Validation {
+    pub reference: String,
+    pub both_miss: u64,
+    pub exact: u64,
+    pub within_tolerance: u64,
+    pub tie: u64,
+    pub boundary: u64,
+    pub edge_ambiguous: u64,
+    pub mismatch: u64,
+    /// Rays where the counted path answered differently from the timed path (a bug).
+    pub counted_path_differs: u64,
+    /// With 0 mismatches in n rays, the 95 % upper bound on the mismatch rate (rule of three).
+    pub mismatch_rate_upper95: f64,
+    pub first_mismatches: Vec<DisputedRay>,
+    /// First few explained disagreements (boundary, edge-ambiguous), for replay.
+    pub first_ambiguous: Vec<DisputedRay>,
+}
+
+impl Validation {
+    pub fn new(reference: &str, counts: VerdictCounts) -> Validation {
+        let n = counts.total().max(1) as f64;
+        let upper95 = if counts.mismatch == 0 {
+            (3.0 / n).min(1.0)
+        } else {
+            counts.mismatch as f64 / n
+        };
+        Validation {
+            reference: reference.to_string(),
+            both_miss: counts.both_miss,
+            exact: counts.exact,
+            within_tolerance: counts.within_tolerance,
+            tie: counts.tie,
+            boundary: counts.boundary,
+            edge_ambiguous: counts.edge_ambiguous,
+            mismatch: counts.mismatch,
+            counted_path_differs: 0,
+            mismatch_rate_upper95: upper95,
+            first_mismatches: Vec::new(),
+            first_ambiguous: Vec::new(),
+        }
+    }
+
+    pub fn rays(&self) -> u64 {
+        self.both_miss
+            + self.exact
+            + self.within_tolerance
+            + self.tie
+            + self.boundary
+            + self.edge_ambiguous
+            + self.mismatch
+    }
+}
+
+/// A ray two answers disagree on, with everything needed to replay it bit for bit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DisputedRay {
+    pub index: usize,
+    pub verdict: String,
+    /// origin xyz, dir xyz, t_min, t_max as hex f32 bit patterns.
+    pub ray_bits: Vec<String>,
+    pub ray: RayDecimal,
+    /// `null` is a miss (or, for any-hit workloads, "not occluded").
+    pub ours: Option<HitRecord>,
+    pub reference: Option<HitRecord>,
+}
+
+/// The same ray in decimal, for people (inputs are always finite except `t_max = inf`,
+/// written as `null`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RayDecimal {
+    pub origin: [f32; 3],
+    pub dir: [f32; 3],
+    pub t_min: f32,
+    pub t_max: Option<f32>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HitRecord {
+    pub prim: u32,
+    pub t: f32,
+    pub t_bits: String,
+    pub u: f32,
+    pub v: f32,
+}
+
+impl HitRecord {
+    pub fn from_hit(h: &Hit) -> HitRecord {
+        // Hits always have finite t (t <= t_max and t > t_min >= 0 with finite coordinates).
+        HitRecord {
+            prim: h.prim,
+            t: h.t,
+            t_bits: format!("{:#010x}", h.t.to_bits()),
+            u: h.u,
+            v: h.v,
+        }
+    }
+}
+
+impl DisputedRay {
+    pub fn new(
+        index: usize,
+        verdict: &str,
+        ray: &Ray,
+        ours: Option<Hit>,
+        reference: Option<Hit>,
+    ) -> DisputedRay {
+        DisputedRay {
+            index,
+            verdict: verdict.to_string(),
+            ray_bits: ray.to_bits().iter().map(|b| format!("{b:#010x}")).collect(),
+            ray: RayDecimal {
+                origin: ray.origin().to_array(),
+                dir: ray.dir().to_array(),
+                t_min: ray.t_min(),
+                t_max: ray.t_max().is_finite().then_some(ray.t_max()),
+            },
+            ours: ours.as_ref().map(HitRecord::from_hit),
+            reference: reference.as_ref().map(HitRecord::from_hit),
+        }
+    }
+}
+
+impl Report {
+    /// Writes `dir/report.json` atomically: a temporary file in the same directory, flushed to
+    /// disk, then renamed over the target, so readers never see a half-written report.
+    pub fn write_atomic(&self, dir: &Path) -> anyhow::Result<std::path::PathBuf> {
+        use anyhow::Context;
+        use std::io::Write;
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let target = dir.join("report.json");
+        let tmp = dir.join(format!(".report.json.{}.tmp", std::process::id()));
+        let json = serde_json::to_vec_pretty(self).context("serialising the report")?;
+        let mut f =
+            std::fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
+        f.write_all(&json)
+            .and_then(|_| f.sync_all())
+            .with_context(|| format!("writing {}", tmp.display()))?;
+        std::fs::rename(&tmp, &target)
+            .with_context(|| format!("renaming {} to {}", tmp.display(), target.display()))?;
+        Ok(target)
+    }
+
+    pub fn read(path: &Path) -> anyhow::Result<Report> {
+        use anyhow::Context;
+        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+        let report: Report = serde_json::from_slice(&bytes)
+            .with_context(|| format!("parsing {}", path.display()))?;
+        anyhow::ensure!(
+            report.schema_version == SCHEMA_VERSION,
+            "{}: schema_version {} is not the supported {}",
+            path.display(),
+            report.schema_version,
+            SCHEMA_VERSION
+        );
+        Ok(report)
+    }
+
+    /// Total mismatches over every structure, scene and workload.
+    pub fn mismatches(&self) -> u64 {
+        self.results
+            .iter()
+            .flat_map(|r| &r.workloads)
+            .map(|w| w.validation.mismatch + w.validation.counted_path_differs)
+            .sum()
+    }
+}

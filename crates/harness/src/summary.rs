@@ -1,0 +1,95 @@
+//! The table printed at the end of a run: build time, throughput and agreement per scene ×
+//! structure, each with its ratio to the reference measured in the same run.
+
+use crate::report::Report;
+use std::fmt::Write;
+
+fn ratio(r: Option<f64>) -> String {
+    r.map(|x| format!("{x:.2}x")).unwrap_or_else(|| "-".into())
+}
+
+pub fn summary_table(report: &Report) -> String {
+    let workloads = &report.run.workloads;
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "{:<22} {:<22} {:>10} {:>7}",
+        "scene", "structure", "build ms", "x ref"
+    );
+    for w in workloads {
+        let _ = write!(out, " {:>10} {:>7}", format!("{w} Mr/s"), "x ref");
+    }
+    let _ = writeln!(out, " {:>9} {:>9}", "ambig.", "mismatch");
+    for r in &report.results {
+        let _ = write!(
+            out,
+            "{:<22} {:<22} {:>10.2} {:>7}",
+            truncate(&r.scene, 22),
+            truncate(&r.structure, 22),
+            r.build.median_ms,
+            ratio(r.build_ratio_to_reference)
+        );
+        for w in workloads {
+            match r.workloads.iter().find(|x| &x.workload == w) {
+                Some(x) => {
+                    let _ = write!(
+                        out,
+                        " {:>10.3} {:>7}",
+                        x.mrays_per_s.median,
+                        ratio(x.speedup_vs_reference)
+                    );
+                }
+                None => {
+                    let _ = write!(out, " {:>10} {:>7}", "-", "-");
+                }
+            }
+        }
+        let ambiguous: u64 = r
+            .workloads
+            .iter()
+            .map(|w| w.validation.boundary + w.validation.edge_ambiguous)
+            .sum();
+        let mismatch: u64 = r
+            .workloads
+            .iter()
+            .map(|w| w.validation.mismatch + w.validation.counted_path_differs)
+            .sum();
+        let _ = writeln!(out, " {ambiguous:>9} {mismatch:>9}");
+    }
+    let rays: u64 = report
+        .results
+        .iter()
+        .flat_map(|r| &r.workloads)
+        .map(|w| w.validation.rays())
+        .sum();
+    let _ = writeln!(
+        out,
+        "\n{} mismatches in {rays} validated rays against {} ({} threads, seed {}).",
+        report.mismatches(),
+        report.run.reference,
+        report.run.threads,
+        report.run.seed
+    );
+    if rays > 0 && report.mismatches() == 0 {
+        let _ = writeln!(
+            out,
+            "95% upper bound on the mismatch rate: {:.1e} (rule of three).",
+            3.0 / rays as f64
+        );
+    }
+    for n in &report.notes {
+        let _ = writeln!(out, "note: {n}");
+    }
+    for e in &report.errors {
+        let _ = writeln!(out, "error: {e}");
+    }
+    out
+}
+
+fn truncate(s: &str, n: usize) -> String {
+    if s.chars().count() <= n {
+        s.to_string()
+    } else {
+        s.chars().take(n - 1).chain(['~']).collect()
+    }
+}

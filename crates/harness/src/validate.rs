@@ -1,0 +1,98 @@
+//! Checks a structure's answers against the reference's, ray by ray, with the validation
+//! classes of `raybench_accel::compare`.
+
+use crate::measure::Answers;
+use crate::report::{DisputedRay, Validation};
+use raybench_accel::Accel;
+use raybench_accel::compare::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
+use raybench_geom::{Ray, TriangleMesh};
+
+/// Disputed rays kept per class in the report.
+const KEEP_EXAMPLES: usize = 10;
+
+pub struct Sides<'a> {
+    pub ours: &'a dyn Accel,
+    pub reference: &'a dyn Accel,
+    pub reference_name: &'a str,
+}
+
+/// Classifies every ray. Any-hit disagreements are arbitrated through both sides' closest hits,
+/// computed for the disputed rays only.
+impl std::fmt::Debug for Sides<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Sides")
+            .field("ours", &self.ours.name())
+            .field("reference", &self.reference.name())
+            .finish()
+    }
+}
+
+pub fn validate(
+    mesh: &TriangleMesh,
+    rays: &[Ray],
+    ours: &Answers,
+    reference: &Answers,
+    sides: &Sides<'_>,
+    tol: &Tolerance,
+) -> Validation {
+    let mut counts = VerdictCounts::default();
+    let mut mismatches = Vec::new();
+    let mut ambiguous = Vec::new();
+    for (i, ray) in rays.iter().enumerate() {
+        let (verdict, a, b) = match (ours, reference) {
+            (Answers::Closest(a), Answers::Closest(b)) => {
+                (classify(mesh, ray, a[i], b[i], tol), a[i], b[i])
+            }
+            (Answers::Any(a), Answers::Any(b)) => {
+                let closest = || (sides.ours.intersect(ray), sides.reference.intersect(ray));
+                let v = classify_occlusion(mesh, ray, a[i], b[i], closest, tol);
+                // Occlusion answers carry no hit; disputed ones show the closest hits.
+                let (ha, hb) = if a[i] == b[i] {
+                    (None, None)
+                } else {
+                    closest()
+                };
+                (v, ha, hb)
+            }
+            _ => unreachable!("answers of one workload share a kind"),
+        };
+        counts.add(verdict);
+        let bucket = match verdict {
+            Verdict::Mismatch => &mut mismatches,
+            Verdict::Boundary | Verdict::EdgeAmbiguous => &mut ambiguous,
+            _ => continue,
+        };
+        if bucket.len() < KEEP_EXAMPLES {
+            bucket.push(DisputedRay::new(i, verdict_name(verdict), ray, a, b));
+        }
+    }
+    let mut v = Validation::new(sides.reference_name, counts);
+    v.first_mismatches = mismatches;
+    v.first_ambiguous = ambiguous;
+    v
+}
+
+pub fn verdict_name(v: Verdict) -> &'static str {
+    match v {
+        Verdict::BothMiss => "both_miss",
+        Verdict::Exact => "exact",
+        Verdict::WithinTolerance => "within_tolerance",
+        Verdict::Tie => "tie",
+        Verdict::Boundary => "boundary",
+        Verdict::EdgeAmbiguous => "edge_ambiguous",
+        Verdict::Mismatch => "mismatch",
+    }
+}
+
+/// Rays where the counted walk answered differently from the timed path.
+pub fn count_differences(timed: &Answers, counted: &Answers) -> u64 {
+    match (timed, counted) {
+        (Answers::Closest(a), Answers::Closest(b)) => {
+            a.iter().zip(b).filter(|(x, y)| x != y).count() as u64
+        }
+        (Answers::Any(a), Answers::Any(b)) => {
+            a.iter().zip(b).filter(|(x, y)| x != y).count() as u64
+        }
+        _ => timed.len() as u64,
+    }
+}

@@ -1,0 +1,83 @@
+//! raybench-scenes: the scenes and rays every structure is measured on.
+//!
+//! * Scenes: procedural generators ([`generate`], listed by [`generators`]) and Wavefront OBJ
+//!   files ([`load_obj`]), both behind [`resolve`]. OBJ files are untrusted input: every problem
+//!   is a [`SceneError`] naming the file (and line), never a panic.
+//! * Workloads ([`Workload`]): primary, random, shadow and diffuse rays. Each is a pure function
+//!   of its inputs and a seed, using `rand_pcg` streams that are independent per purpose.
+//! * Suites ([`Suite`]): JSON manifests in the repository's `bench-scenes/`.
+#![forbid(unsafe_code)]
+
+mod error;
+mod generate;
+mod obj;
+mod rng;
+mod suite;
+mod view;
+mod workload;
+
+pub use error::SceneError;
+pub use generate::{GeneratorInfo, MAX_TRIANGLES, generate, generators};
+pub use obj::load_obj;
+pub use suite::{Suite, SuiteScene, list_suites, load_suite, resolve_suite_scenes, suites_dir};
+pub use view::{Camera, View};
+pub use workload::{
+    SHADOW_T_MAX, SurfaceHit, Workload, diffuse_rays, primary_rays, random_rays, shadow_rays,
+};
+
+use raybench_geom::{RemovedTriangles, TriangleMesh};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+// Re-exported so users of the scene API need not depend on raybench-geom for `View`'s fields.
+pub use raybench_geom::Vec3;
+
+/// A mesh ready to trace, with where it came from and how to look at it.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// "sphere", "soup", "plane", or the OBJ file stem (e.g. "stanford-bunny").
+    pub name: String,
+    pub source: SceneSource,
+    pub mesh: Arc<TriangleMesh>,
+    /// Triangles [`TriangleMesh::new`] removed (and zero-area ones it kept), for the report.
+    pub removed: RemovedTriangles,
+    /// What the loader skipped or changed, e.g. "12 point/line elements skipped".
+    pub loader_notes: Vec<String>,
+    pub view: View,
+}
+
+/// Where a scene came from, enough to make it again.
+///
+/// Serialises as `{"procedural": {"generator": "sphere", "params": {...}, "seed": 1}}` or
+/// `{"obj": {"path": "..."}}`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SceneSource {
+    Procedural {
+        generator: String,
+        /// Every parameter, defaults filled in (counts as integers).
+        params: BTreeMap<String, serde_json::Value>,
+        seed: u64,
+    },
+    Obj {
+        path: PathBuf,
+    },
+}
+
+/// A scene from a spec: a path ending in `.obj` (any case) is loaded, anything else is a
+/// generator spec such as `sphere:triangles=20000`.
+pub fn resolve(spec: &str, seed: u64) -> Result<Scene, SceneError> {
+    if is_obj_path(spec) {
+        load_obj(Path::new(spec))
+    } else {
+        generate(spec, seed)
+    }
+}
+
+fn is_obj_path(spec: &str) -> bool {
+    spec.len() >= 4
+        && spec.is_char_boundary(spec.len() - 4)
+        && spec[spec.len() - 4..].eq_ignore_ascii_case(".obj")
+}

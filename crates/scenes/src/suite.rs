@@ -1,0 +1,134 @@
+//! Suite manifests: JSON files in the repository's `bench-scenes/` naming scenes, structures,
+//! workloads and the ray count of a benchmark run.
+
+use crate::{Scene, SceneError, Workload, generate, load_obj};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// One benchmark suite, as read from a manifest.
+#[derive(Deserialize, Serialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Suite {
+    pub name: String,
+    pub description: String,
+    pub scenes: Vec<SuiteScene>,
+    /// Structure names as the harness knows them ("bvh-binned-sah", "embree-high", …).
+    pub structures: Vec<String>,
+    pub workloads: Vec<Workload>,
+    /// Rays per workload (primary rays: about this many pixels).
+    pub rays: usize,
+}
+
+/// A scene of a suite: a [`generate`] spec, or an OBJ file.
+#[derive(Deserialize, Serialize, Clone, Debug, PartialEq)]
+#[serde(untagged)]
+pub enum SuiteScene {
+    Generated(String),
+    File {
+        /// Relative to the directory of the manifest file.
+        obj: String,
+        /// An optional file that is absent is skipped with a note; present but broken is an error.
+        #[serde(default)]
+        optional: bool,
+    },
+}
+
+/// Reads and checks a manifest: valid JSON of the right shape, no unknown fields, and at least
+/// one scene, structure and workload, and a non-zero ray count.
+pub fn load_suite(path: &Path) -> Result<Suite, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::io(path, e))?;
+    let suite: Suite = serde_json::from_str(&text).map_err(|source| SceneError::SuiteJson {
+        path: path.to_owned(),
+        source,
+    })?;
+    check_suite(&suite).map_err(|problem| SceneError::Suite {
+        path: path.to_owned(),
+        problem,
+    })?;
+    Ok(suite)
+}
+
+fn check_suite(suite: &Suite) -> Result<(), String> {
+    let empty = [
+        ("scenes", suite.scenes.is_empty()),
+        ("structures", suite.structures.is_empty()),
+        ("workloads", suite.workloads.is_empty()),
+    ];
+    if let Some((field, _)) = empty.iter().find(|(_, is_empty)| *is_empty) {
+        return Err(format!("suite `{}` lists no {field}", suite.name));
+    }
+    if suite.rays == 0 {
+        return Err(format!("suite `{}` has rays = 0", suite.name));
+    }
+    Ok(())
+}
+
+/// The repository's `bench-scenes/` directory: `$RAYBENCH_SUITES` if set, else the directory
+/// next to this crate's workspace.
+pub fn suites_dir() -> PathBuf {
+    match std::env::var_os("RAYBENCH_SUITES") {
+        Some(dir) => PathBuf::from(dir),
+        None => PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../bench-scenes")),
+    }
+}
+
+/// Every `*.json` manifest in [`suites_dir`], sorted by file name. Any broken manifest is an error.
+pub fn list_suites() -> Result<Vec<(PathBuf, Suite)>, SceneError> {
+    let dir = suites_dir();
+    let entries = std::fs::read_dir(&dir).map_err(|e| SceneError::io(&dir, e))?;
+    let mut paths = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(|e| SceneError::io(&dir, e))?.path();
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            paths.push(path);
+        }
+    }
+    paths.sort();
+    paths
+        .into_iter()
+        .map(|p| load_suite(&p).map(|s| (p, s)))
+        .collect()
+}
+
+/// Makes every scene of a suite, in manifest order.
+///
+/// Returns one `Result` per scene that was attempted (so the caller can report each failure
+/// and decide whether to go on), and notes for optional files that were skipped because they
+/// are absent, e.g. `"skipped ../../shared/scenes/x.obj (optional): /abs/x.obj does not exist"`.
+/// A present but broken file is an `Err`, never a note. File paths are relative to the
+/// directory of `suite_path`.
+pub fn resolve_suite_scenes(
+    suite_path: &Path,
+    suite: &Suite,
+    seed: u64,
+) -> (Vec<Result<Scene, SceneError>>, Vec<String>) {
+    let base = suite_path.parent().unwrap_or(Path::new("."));
+    let mut scenes = Vec::new();
+    let mut notes = Vec::new();
+    for entry in &suite.scenes {
+        match entry {
+            SuiteScene::Generated(spec) => scenes.push(generate(spec, seed)),
+            SuiteScene::File { obj, optional } => {
+                let path = base.join(obj);
+                if *optional && is_absent(&path) {
+                    notes.push(format!(
+                        "skipped {obj} (optional): {} does not exist",
+                        path.display()
+                    ));
+                } else {
+                    scenes.push(load_obj(&path));
+                }
+            }
+        }
+    }
+    (scenes, notes)
+}
+
+/// Absent means "not found" (including a missing parent folder); a file that exists but cannot
+/// be read is not absent, and its load error is reported.
+fn is_absent(path: &Path) -> bool {
+    matches!(std::fs::metadata(path), Err(e) if e.kind() == std::io::ErrorKind::NotFound)
+}

@@ -1,0 +1,156 @@
+//! raybench-testkit: the conformance suite every structure runs, written once.
+//!
+//! A structure crate calls it from a test in a few lines:
+//!
+//! ```text
+//! #[test]
+//! fn conforms() {
+//!     raybench_testkit::conformance::<MyAccel>(&MyParams::default(), &|a, mesh| a.validate(mesh));
+//! }
+//! ```
+//!
+//! Every check compares the structure with [`BruteForce`] on named, seeded scenes and ray sets,
+//! classifying each ray with `raybench_accel::compare` and requiring zero mismatches; the
+//! structure's own `validate()` runs after every build; the counted walk must give the same
+//! answers as the timed walk; any-hit must agree with closest-hit. On failure the message names
+//! the case, the seed and the exact ray bits.
+#![forbid(unsafe_code)]
+
+mod cases;
+mod rays;
+
+pub use cases::{Case, edge_cases, seeded_cases};
+pub use rays::{centroid_rays, random_rays_in, seeded_rng};
+
+use raybench_accel::compare::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
+use raybench_accel::{Accel, BruteForce, Counters};
+use raybench_geom::{Ray, TriangleMesh};
+use std::sync::Arc;
+
+/// A structure-specific invariant check (`validate()`), run after every build.
+pub type Validator<'a, A> = &'a dyn Fn(&A, &TriangleMesh) -> Result<(), String>;
+
+/// No structure-specific invariants (for wrappers such as Embree).
+pub fn no_validation<A>(_: &A, _: &TriangleMesh) -> Result<(), String> {
+    Ok(())
+}
+
+/// Runs every case (seeded scenes and edge cases) and panics with details on the first failure.
+/// Returns the verdict counts over all cases so callers can print or check them.
+pub fn conformance<A: Accel>(params: &A::Params, validate: Validator<'_, A>) -> VerdictCounts {
+    let mut total = VerdictCounts::default();
+    for case in seeded_cases().into_iter().chain(edge_cases()) {
+        let counts = check_case::<A>(&case, params, validate).unwrap_or_else(|e| panic!("{e}"));
+        add_counts(&mut total, &counts);
+    }
+    eprintln!("conformance: {total:?}");
+    total
+}
+
+fn add_counts(total: &mut VerdictCounts, c: &VerdictCounts) {
+    total.both_miss += c.both_miss;
+    total.exact += c.exact;
+    total.within_tolerance += c.within_tolerance;
+    total.tie += c.tie;
+    total.boundary += c.boundary;
+    total.edge_ambiguous += c.edge_ambiguous;
+    total.mismatch += c.mismatch;
+}
+
+/// Checks one case; `Err` describes the first problem.
+pub fn check_case<A: Accel>(
+    case: &Case,
+    params: &A::Params,
+    validate: Validator<'_, A>,
+) -> Result<VerdictCounts, String> {
+    let mesh = case.mesh.clone();
+    let accel =
+        A::build(mesh.clone(), params).map_err(|e| format!("{}: build failed: {e}", case.name))?;
+    validate(&accel, &mesh).map_err(|e| format!("{}: validate() after build: {e}", case.name))?;
+    let oracle =
+        BruteForce::build(mesh.clone(), &Default::default()).expect("brute force always builds");
+    let tol = Tolerance::default();
+    let mut counts = VerdictCounts::default();
+    for (i, ray) in case.rays.iter().enumerate() {
+        let fail = |what: &str| {
+            format!(
+                "{} (seed {:#x}) ray {i} {:08x?}: {what}",
+                case.name,
+                case.seed,
+                ray.to_bits()
+            )
+        };
+        let ours = accel.intersect(ray);
+        let expected = oracle.intersect(ray);
+        let verdict = classify(&mesh, ray, ours, expected, &tol);
+        counts.add(verdict);
+        if verdict == Verdict::Mismatch {
+            return Err(fail(&format!(
+                "closest hit {ours:?}, brute force {expected:?}"
+            )));
+        }
+        let mut c = Counters::default();
+        if accel.intersect_counted(ray, &mut c) != ours {
+            return Err(fail("intersect_counted differs from intersect"));
+        }
+        let occluded = accel.occluded(ray);
+        if accel.occluded_counted(ray, &mut Counters::default()) != occluded {
+            return Err(fail("occluded_counted differs from occluded"));
+        }
+        if occluded != ours.is_some() {
+            return Err(fail(&format!(
+                "occluded() = {occluded} but intersect() = {ours:?}"
+            )));
+        }
+        let any = classify_occlusion(
+            &mesh,
+            ray,
+            occluded,
+            oracle.occluded(ray),
+            || (ours, expected),
+            &tol,
+        );
+        if any == Verdict::Mismatch {
+            return Err(fail("occluded() disagrees with brute force"));
+        }
+    }
+    check_batch_path(&accel, case)?;
+    Ok(counts)
+}
+
+/// The prepared batch path (what the harness times) must answer exactly as the single-ray path.
+fn check_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), String> {
+    let rays: Vec<Ray> = case
+        .rays
+        .iter()
+        .copied()
+        .filter(|r| r.check().is_ok())
+        .collect();
+    let prepared = accel
+        .prepare_rays(&rays)
+        .map_err(|e| format!("{}: prepare_rays: {e}", case.name))?;
+    let mut hits = vec![None; rays.len()];
+    accel.intersect_prepared(&rays, &prepared, 0, &mut hits);
+    let mut occ = vec![false; rays.len()];
+    accel.occluded_prepared(&rays, &prepared, 0, &mut occ);
+    for (i, r) in rays.iter().enumerate() {
+        if hits[i] != accel.intersect(r) || occ[i] != accel.occluded(r) {
+            return Err(format!(
+                "{}: batch path differs from single-ray path on ray {:08x?}",
+                case.name,
+                r.to_bits()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Builds a mesh from positions and indices for a case, panicking on meshes tests should never
+/// produce (too many vertices).
+pub fn mesh(positions: Vec<raybench_geom::Vec3>, indices: Vec<[u32; 3]>) -> Arc<TriangleMesh> {
+    Arc::new(
+        TriangleMesh::new(positions, indices)
+            .expect("test mesh fits 32-bit indices")
+            .0,
+    )
+}
