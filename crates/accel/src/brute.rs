@@ -3,7 +3,7 @@
 //! t) resolve to the lowest primitive index.
 
 use crate::{Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, NoCount};
-use raybench_geom::{Ray, Triangle, TriangleMesh, TriangleTest};
+use raybench_geom::{MollerTriangle, Ray, TriHit, Triangle, TriangleMesh, TriangleTest};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -15,34 +15,65 @@ pub struct BruteForceParams {
 #[derive(Debug)]
 pub struct BruteForce {
     name: String,
-    test: TriangleTest,
-    triangles: Vec<Triangle>,
+    triangles: Triangles,
+}
+
+/// Triangles in the layout their test wants: Möller–Trumbore reads Embree's precomputed
+/// `v0, e1, e2, Ng`; the watertight test reads the vertices.
+#[derive(Debug)]
+enum Triangles {
+    Moller(Vec<MollerTriangle>),
+    Vertices(Vec<Triangle>),
 }
 
 impl BruteForce {
     fn trace<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut r = *ray;
-        for (prim, tri) in self.triangles.iter().enumerate() {
-            c.prim_tests(1);
-            let Some(h) = tri.intersect(&r, self.test) else {
-                continue;
-            };
-            if best.is_some_and(|b| h.t >= b.t) {
-                continue; // equal t: keep the lower primitive index
+        match &self.triangles {
+            Triangles::Moller(t) => scan::<ANY_HIT, _, _>(t, ray, c, |t, r| t.intersect(r)),
+            Triangles::Vertices(t) => {
+                scan::<ANY_HIT, _, _>(t, ray, c, |t, r| t.intersect_watertight(r))
             }
-            best = Some(Hit {
-                t: h.t,
-                prim: prim as u32,
-                u: h.u,
-                v: h.v,
-            });
-            if ANY_HIT {
-                break;
-            }
-            r = r.with_t_max(h.t);
         }
-        best
+    }
+}
+
+/// The one loop: every triangle, keeping the closest hit (the lowest index on equal t), or
+/// stopping at the first hit for any-hit queries.
+#[inline(always)]
+fn scan<const ANY_HIT: bool, T, C: CounterSink>(
+    tris: &[T],
+    ray: &Ray,
+    c: &mut C,
+    test: impl Fn(&T, &Ray) -> Option<TriHit>,
+) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    let mut r = *ray;
+    for (prim, tri) in tris.iter().enumerate() {
+        c.prim_tests(1);
+        let Some(h) = test(tri, &r) else { continue };
+        if best.is_some_and(|b| h.t >= b.t) {
+            continue; // equal t: keep the lower primitive index
+        }
+        best = Some(Hit {
+            t: h.t,
+            prim: prim as u32,
+            u: h.u,
+            v: h.v,
+        });
+        if ANY_HIT {
+            break;
+        }
+        r = r.with_t_max(h.t);
+    }
+    best
+}
+
+impl BruteForce {
+    fn len(&self) -> usize {
+        match &self.triangles {
+            Triangles::Moller(t) => t.len(),
+            Triangles::Vertices(t) => t.len(),
+        }
     }
 }
 
@@ -54,10 +85,15 @@ impl Accel for BruteForce {
             TriangleTest::MollerTrumbore => "bruteforce",
             TriangleTest::Watertight => "bruteforce-watertight",
         };
+        let triangles = match params.triangle_test {
+            TriangleTest::MollerTrumbore => {
+                Triangles::Moller(mesh.triangles().map(|t| MollerTriangle::new(&t)).collect())
+            }
+            TriangleTest::Watertight => Triangles::Vertices(mesh.triangles().collect()),
+        };
         Ok(BruteForce {
             name: name.to_string(),
-            test: params.triangle_test,
-            triangles: mesh.triangles().collect(),
+            triangles,
         })
     }
 
@@ -82,12 +118,12 @@ impl Accel for BruteForce {
     }
 
     fn build_stats(&self) -> BuildStats {
-        let n = self.triangles.len() as f64;
+        let n = self.len() as f64;
         BuildStats {
             nodes: 0,
             leaves: 1,
             max_depth: 0,
-            refs: self.triangles.len() as u64,
+            refs: self.len() as u64,
             // One leaf holding everything: every ray pays every test.
             sah_cost: Some(n * crate::SAH_INTERSECTION_COST),
             extra: Default::default(),
@@ -95,8 +131,12 @@ impl Accel for BruteForce {
     }
 
     fn memory(&self) -> Memory {
+        let bytes = match &self.triangles {
+            Triangles::Moller(t) => std::mem::size_of_val(t.as_slice()),
+            Triangles::Vertices(t) => std::mem::size_of_val(t.as_slice()),
+        };
         Memory {
-            primitives: std::mem::size_of_val(self.triangles.as_slice()) as u64,
+            primitives: bytes as u64,
             ..Memory::default()
         }
     }

@@ -20,7 +20,7 @@ pub use aabb::Aabb;
 pub use glam::{DVec3, Vec3};
 pub use mesh::{MeshError, RemovedTriangles, TriangleMesh};
 pub use ray::{EMBREE_LARGE, Ray, RayError};
-pub use triangle::{TriHit, Triangle, TriangleTest};
+pub use triangle::{MollerTriangle, TriHit, Triangle, TriangleTest};
 
 /// Largest finite value that still compares correctly: `max` of two floats, ignoring a NaN in
 /// `candidate`. Written as a comparison so it compiles to one `maxss` (NaN in `candidate` keeps

@@ -29,6 +29,61 @@ pub struct Triangle {
     pub v2: Vec3,
 }
 
+/// A triangle in the layout Embree's fast mode stores (`Triangle4`: `v0`, `e1 = v0 - v1`,
+/// `e2 = v2 - v0`, `Ng = e2 × e1`), precomputed once so each test skips two subtractions and a
+/// cross product. [`Triangle::intersect_moller`] goes through this type, so both give
+/// bit-identical answers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MollerTriangle {
+    pub v0: Vec3,
+    pub e1: Vec3,
+    pub e2: Vec3,
+    pub ng: Vec3,
+}
+
+impl MollerTriangle {
+    #[inline(always)]
+    pub fn new(t: &Triangle) -> MollerTriangle {
+        let e1 = t.v0 - t.v1;
+        let e2 = t.v2 - t.v0;
+        MollerTriangle {
+            v0: t.v0,
+            e1,
+            e2,
+            ng: e2.cross(e1),
+        }
+    }
+
+    /// Möller–Trumbore (1997) arranged as Embree's fast mode does it: edge tests on the
+    /// unnormalised `U`, `V` against `|den|` and the depth test `|den| t_min < T <= |den| t_max`
+    /// (strict at `t_min`, inclusive at `t_max`). Only `den == 0` is rejected — no absolute
+    /// epsilon, so tiny triangles are hit (tinybvh #283) and zero-area triangles never are.
+    /// Every comparison is false on NaN.
+    #[inline(always)]
+    pub fn intersect(&self, ray: &Ray) -> Option<TriHit> {
+        let c = self.v0 - ray.origin();
+        let r = c.cross(ray.dir());
+        let den = self.ng.dot(ray.dir());
+        let abs_den = den.abs();
+        let flip = |x: f32| if den.is_sign_negative() { -x } else { x };
+        let u = flip(r.dot(self.e2));
+        let v = flip(r.dot(self.e1));
+        if !(den != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= abs_den) {
+            return None;
+        }
+        let t = flip(self.ng.dot(c));
+        if !(abs_den * ray.t_min() < t && t <= abs_den * ray.t_max()) {
+            return None;
+        }
+        let inv = 1.0 / abs_den;
+        Some(TriHit {
+            t: t * inv,
+            u: u * inv,
+            v: v * inv,
+        })
+    }
+}
+
 /// A double-precision look at where a ray meets a triangle's plane, used to arbitrate disputed
 /// rays: `edge_distance` is the signed distance from that point to the nearest edge
 /// (positive inside), `scale` the largest coordinate magnitude involved.
@@ -82,36 +137,10 @@ impl Triangle {
         }
     }
 
-    /// Möller–Trumbore (1997) arranged as Embree's fast mode does it: edges `e1 = v0 - v1`,
-    /// `e2 = v2 - v0`, normal `e2 × e1`, edge tests on the unnormalised `U`, `V` against `|den|`
-    /// and the depth test `|den| t_min < T <= |den| t_max` (strict at `t_min`, inclusive at
-    /// `t_max`). Only `den == 0` is rejected — no absolute epsilon, so tiny triangles are hit
-    /// (tinybvh #283) and zero-area triangles never are. Every comparison is false on NaN.
+    /// Möller–Trumbore in Embree's fast-mode arrangement; see [`MollerTriangle::intersect`].
     #[inline(always)]
     pub fn intersect_moller(&self, ray: &Ray) -> Option<TriHit> {
-        let e1 = self.v0 - self.v1;
-        let e2 = self.v2 - self.v0;
-        let ng = e2.cross(e1);
-        let c = self.v0 - ray.origin();
-        let r = c.cross(ray.dir());
-        let den = ng.dot(ray.dir());
-        let abs_den = den.abs();
-        let flip = |x: f32| if den.is_sign_negative() { -x } else { x };
-        let u = flip(r.dot(e2));
-        let v = flip(r.dot(e1));
-        if !(den != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= abs_den) {
-            return None;
-        }
-        let t = flip(ng.dot(c));
-        if !(abs_den * ray.t_min() < t && t <= abs_den * ray.t_max()) {
-            return None;
-        }
-        let inv = 1.0 / abs_den;
-        Some(TriHit {
-            t: t * inv,
-            u: u * inv,
-            v: v * inv,
-        })
+        MollerTriangle::new(self).intersect(ray)
     }
 
     /// The watertight test of Woop, Benthin and Wald (JCGT 2(1), 2013): shear the triangle into

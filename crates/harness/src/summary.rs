@@ -5,7 +5,18 @@ use crate::report::Report;
 use std::fmt::Write;
 
 fn ratio(r: Option<f64>) -> String {
-    r.map(|x| format!("{x:.2}x")).unwrap_or_else(|| "-".into())
+    r.map(|x| format!("{}x", sig(x)))
+        .unwrap_or_else(|| "-".into())
+}
+
+/// Three significant digits however small the value (brute force runs at 1e-3 Mrays/s).
+fn sig(x: f64) -> String {
+    if x == 0.0 || x.abs() >= 100.0 {
+        format!("{x:.0}")
+    } else {
+        let decimals = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+        format!("{x:.decimals$}")
+    }
 }
 
 pub fn summary_table(report: &Report) -> String {
@@ -23,10 +34,10 @@ pub fn summary_table(report: &Report) -> String {
     for r in &report.results {
         let _ = write!(
             out,
-            "{:<22} {:<22} {:>10.2} {:>7}",
+            "{:<22} {:<22} {:>10} {:>7}",
             truncate(&r.scene, 22),
             truncate(&r.structure, 22),
-            r.build.median_ms,
+            sig(r.build.median_ms),
             ratio(r.build_ratio_to_reference)
         );
         for w in workloads {
@@ -34,8 +45,8 @@ pub fn summary_table(report: &Report) -> String {
                 Some(x) => {
                     let _ = write!(
                         out,
-                        " {:>10.3} {:>7}",
-                        x.mrays_per_s.median,
+                        " {:>10} {:>7}",
+                        sig(x.mrays_per_s.median),
                         ratio(x.speedup_vs_reference)
                     );
                 }
@@ -84,6 +95,17 @@ pub fn summary_table(report: &Report) -> String {
         let _ = writeln!(out, "error: {e}");
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn three_significant_digits() {
+        assert_eq!(super::sig(0.001234), "0.00123");
+        assert_eq!(super::sig(24.863), "24.9");
+        assert_eq!(super::sig(1.0), "1.00");
+        assert_eq!(super::sig(1234.5), "1234");
+    }
 }
 
 fn truncate(s: &str, n: usize) -> String {

@@ -91,8 +91,8 @@ fn bad_lines_are_rejected_with_their_line_number() {
         ),
         (
             "garbage_line.obj",
-            format!("{TRIANGLE}f 1 2 3\nhello there\n"),
-            "line 5: `hello` is not an OBJ statement",
+            format!("{TRIANGLE}f 1 2 3\n%#@! there\n"),
+            "line 5: `%#@!` is not an OBJ statement",
         ),
         (
             "relative_vt.obj",

@@ -238,6 +238,10 @@ fn scan_notes(scan: &Scan) -> Vec<String> {
         scan.mtllib_lines,
         "`mtllib` statements ignored (materials are never read)",
     );
+    note(
+        scan.unknown_statements,
+        "statements with unknown keywords ignored (as tobj does)",
+    );
     notes
 }
 

@@ -37,6 +37,9 @@ pub(super) struct Scan {
     /// `p`, `curv`, `curv2`, `surf`: geometry tobj ignores.
     pub ignored_geometry: u64,
     pub mtllib_lines: u64,
+    /// Statements with an unknown but well-formed keyword (vendor extensions): ignored, as
+    /// tobj does, and counted so the loader can say so.
+    pub unknown_statements: u64,
 }
 
 /// OBJ statements tobj ignores without carrying triangle geometry (Wavefront OBJ spec, plus `s`).
@@ -156,6 +159,11 @@ impl State {
             "usemtl" => {}
             k if IGNORED_GEOMETRY_KEYWORDS.contains(&k) => self.scan.ignored_geometry += 1,
             k if HARMLESS_KEYWORDS.contains(&k) => {}
+            // A word keyword tobj would ignore (an exporter's extension) is counted, not fatal;
+            // anything else at the start of a line is garbage or a cut-off file.
+            k if k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') => {
+                self.scan.unknown_statements += 1
+            }
             other => {
                 return Err(format!(
                     "`{}` is not an OBJ statement (garbage or a truncated file?)",
@@ -433,10 +441,19 @@ mod tests {
     }
 
     #[test]
-    fn unknown_statements_are_rejected_but_comments_are_not() {
+    fn garbage_statements_are_rejected_but_comments_and_extensions_are_not() {
         assert_eq!(problem("#### header\n# c\ns off\nmtllib a.mtl\n"), None);
-        let p = problem("v 0 0 0\nhello world\n").unwrap();
+        assert_eq!(
+            problem("v 0 0 0\nhello world\n"),
+            None,
+            "unknown keyword: ignored, counted"
+        );
+        assert_eq!(
+            scan("v 0 0 0\nhello world\nxyz_1 2\n").unknown_statements,
+            2
+        );
+        let p = problem("v 0 0 0\n@!%$ world\n").unwrap();
         assert_eq!(p.line, 2);
-        assert!(p.problem.contains("`hello` is not an OBJ statement"));
+        assert!(p.problem.contains("`@!%$` is not an OBJ statement"));
     }
 }
