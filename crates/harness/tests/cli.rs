@@ -78,3 +78,63 @@ fn bad_arguments_fail_with_a_message() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-suite"));
 }
+
+#[test]
+fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
+    let dir = std::env::temp_dir().join(format!("raybench-ci-suite-{}", std::process::id()));
+    let out = raybench()
+        .args([
+            "run",
+            "--suite",
+            "ci",
+            "--rays",
+            "3000",
+            "--build-runs",
+            "1",
+            "--trace-runs",
+            "1",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = raybench_harness::report::Report::read(&dir.join("report.json")).unwrap();
+    assert_eq!(report.mismatches(), 0);
+    assert!(report.errors.is_empty(), "{:?}", report.errors);
+    let scenes: Vec<&str> = report.scenes.iter().map(|s| s.name.as_str()).collect();
+    for name in ["sphere", "soup", "plane"] {
+        assert!(scenes.contains(&name), "{scenes:?}");
+    }
+    if std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/scenes/stanford-bunny.obj"
+    ))
+    .exists()
+    {
+        assert!(scenes.contains(&"stanford-bunny"), "{scenes:?}");
+        assert!(
+            report
+                .notes
+                .iter()
+                .any(|n| n.contains("bruteforce skipped on stanford-bunny")),
+            "{:?}",
+            report.notes
+        );
+    } else {
+        eprintln!(
+            "NOT CHECKED: ../shared/scenes is absent, so the suite's bunny was skipped (as a note)"
+        );
+        assert!(
+            report.notes.iter().any(|n| n.contains("stanford-bunny")),
+            "{:?}",
+            report.notes
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

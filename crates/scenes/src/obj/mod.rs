@@ -58,7 +58,7 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
         source: SceneSource::Obj {
             path: path.to_owned(),
         },
-        view: View::of_bounds(&mesh.bounds()),
+        view: View::of_mesh(&mesh),
         mesh: Arc::new(mesh),
         removed,
         loader_notes,
