@@ -180,6 +180,18 @@ pub struct VerdictCounts {
     pub mismatch: u64,
 }
 
+impl std::ops::AddAssign for VerdictCounts {
+    fn add_assign(&mut self, o: VerdictCounts) {
+        self.both_miss += o.both_miss;
+        self.exact += o.exact;
+        self.within_tolerance += o.within_tolerance;
+        self.tie += o.tie;
+        self.boundary += o.boundary;
+        self.edge_ambiguous += o.edge_ambiguous;
+        self.mismatch += o.mismatch;
+    }
+}
+
 impl VerdictCounts {
     pub fn add(&mut self, v: Verdict) {
         *match v {

@@ -105,6 +105,24 @@ fn list() -> Result<()> {
         "  {:<24} {}",
         "PATH.obj", "a Wavefront OBJ file (triangulated, positions only)"
     );
+    let shared = raybench_scenes::suites_dir().join("../../shared/scenes");
+    match std::fs::read_dir(&shared) {
+        Ok(entries) => {
+            let mut files: Vec<PathBuf> = entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("obj")))
+                .collect();
+            files.sort();
+            println!("\nReal scenes ({}):", shared.display());
+            for f in files {
+                println!("  {}", f.display());
+            }
+        }
+        Err(_) => println!(
+            "\nReal scenes: {} is absent (suites skip those files with a note)",
+            shared.display()
+        ),
+    }
     println!("\nWorkloads:");
     for w in Workload::ALL {
         println!("  {:<24} {}", w.name(), w.description());

@@ -147,13 +147,10 @@ impl CountersPerRay {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Validation {
     pub reference: String,
-    pub both_miss: u64,
-    pub exact: u64,
-    pub within_tolerance: u64,
-    pub tie: u64,
-    pub boundary: u64,
-    pub edge_ambiguous: u64,
-    pub mismatch: u64,
+    /// Rays per class: `both_miss`, `exact`, `within_tolerance`, `tie`, `boundary`,
+    /// `edge_ambiguous`, `mismatch` (written flat into this object).
+    #[serde(flatten)]
+    pub counts: VerdictCounts,
     /// Rays where the counted path answered differently from the timed path (a bug).
     pub counted_path_differs: u64,
     /// With 0 mismatches in n rays, the 95 % upper bound on the mismatch rate (rule of three).
@@ -173,13 +170,7 @@ impl Validation {
         };
         Validation {
             reference: reference.to_string(),
-            both_miss: counts.both_miss,
-            exact: counts.exact,
-            within_tolerance: counts.within_tolerance,
-            tie: counts.tie,
-            boundary: counts.boundary,
-            edge_ambiguous: counts.edge_ambiguous,
-            mismatch: counts.mismatch,
+            counts,
             counted_path_differs: 0,
             mismatch_rate_upper95: upper95,
             first_mismatches: Vec::new(),
@@ -188,13 +179,7 @@ impl Validation {
     }
 
     pub fn rays(&self) -> u64 {
-        self.both_miss
-            + self.exact
-            + self.within_tolerance
-            + self.tie
-            + self.boundary
-            + self.edge_ambiguous
-            + self.mismatch
+        self.counts.total()
     }
 }
 
@@ -307,7 +292,7 @@ impl Report {
         self.results
             .iter()
             .flat_map(|r| &r.workloads)
-            .map(|w| w.validation.mismatch + w.validation.counted_path_differs)
+            .map(|w| w.validation.counts.mismatch + w.validation.counted_path_differs)
             .sum()
     }
 }

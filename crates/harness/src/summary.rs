@@ -58,12 +58,12 @@ pub fn summary_table(report: &Report) -> String {
         let ambiguous: u64 = r
             .workloads
             .iter()
-            .map(|w| w.validation.boundary + w.validation.edge_ambiguous)
+            .map(|w| w.validation.counts.ambiguous())
             .sum();
         let mismatch: u64 = r
             .workloads
             .iter()
-            .map(|w| w.validation.mismatch + w.validation.counted_path_differs)
+            .map(|w| w.validation.counts.mismatch + w.validation.counted_path_differs)
             .sum();
         let _ = writeln!(out, " {ambiguous:>9} {mismatch:>9}");
     }

@@ -57,7 +57,7 @@ fn bruteforce_and_every_embree_variant_agree() {
         for w in &r.workloads {
             let v = &w.validation;
             assert_eq!(
-                v.mismatch, 0,
+                v.counts.mismatch, 0,
                 "{} on {} / {}: {:?}",
                 r.structure, r.scene, w.workload, v.first_mismatches
             );
@@ -74,7 +74,7 @@ fn bruteforce_and_every_embree_variant_agree() {
             );
             if r.structure == "embree-medium" {
                 assert_eq!(
-                    v.exact + v.both_miss,
+                    v.counts.exact + v.counts.both_miss,
                     w.rays as u64,
                     "the reference agrees with itself exactly"
                 );
@@ -154,7 +154,7 @@ fn same_seed_gives_identical_rays_and_counters() {
                         w.workload,
                         w.rays,
                         w.counters_total,
-                        (w.validation.exact, w.validation.both_miss, w.validation.tie)
+                        w.validation.counts
                     )
                 })
             })

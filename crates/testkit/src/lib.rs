@@ -41,20 +41,10 @@ pub fn conformance<A: Accel>(params: &A::Params, validate: Validator<'_, A>) -> 
     let mut total = VerdictCounts::default();
     for case in seeded_cases().into_iter().chain(edge_cases()) {
         let counts = check_case::<A>(&case, params, validate).unwrap_or_else(|e| panic!("{e}"));
-        add_counts(&mut total, &counts);
+        total += counts;
     }
     eprintln!("conformance: {total:?}");
     total
-}
-
-fn add_counts(total: &mut VerdictCounts, c: &VerdictCounts) {
-    total.both_miss += c.both_miss;
-    total.exact += c.exact;
-    total.within_tolerance += c.within_tolerance;
-    total.tie += c.tie;
-    total.boundary += c.boundary;
-    total.edge_ambiguous += c.edge_ambiguous;
-    total.mismatch += c.mismatch;
 }
 
 /// Checks one case; `Err` describes the first problem.
