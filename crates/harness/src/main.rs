@@ -97,8 +97,8 @@ fn list() -> Result<()> {
     println!("\nScene generators (spec: name[:key=value,...]):");
     for g in raybench_scenes::generators() {
         println!("  {:<24} {}", g.name, g.description);
-        for (k, v) in g.params {
-            println!("  {:<24}   {k}: {v}", "");
+        for p in g.params {
+            println!("  {:<24}   {}: {}", "", p.key, p.describe());
         }
     }
     println!(

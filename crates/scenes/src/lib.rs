@@ -10,6 +10,7 @@
 
 mod error;
 mod generate;
+mod material;
 mod obj;
 mod rng;
 mod suite;
@@ -17,7 +18,8 @@ mod view;
 mod workload;
 
 pub use error::SceneError;
-pub use generate::{GeneratorInfo, MAX_TRIANGLES, generate, generators};
+pub use generate::{GeneratorInfo, Kind, MAX_TRIANGLES, ParamInfo, generate, generators};
+pub use material::Material;
 pub use obj::load_obj;
 pub use suite::{Suite, SuiteScene, list_suites, load_suite, resolve_suite_scenes, suites_dir};
 pub use view::{Camera, View};
@@ -45,7 +47,36 @@ pub struct Scene {
     pub removed: RemovedTriangles,
     /// What the loader skipped or changed, e.g. "12 point/line elements skipped".
     pub loader_notes: Vec<String>,
+    /// The default view (primary rays use it).
     pub view: View,
+    /// Every named view of the scene; the first is the one `view` defaults to.
+    pub views: Vec<NamedView>,
+    /// At least one entry; `triangle_materials` indexes it.
+    pub materials: Vec<Material>,
+    /// Material per triangle; empty means every triangle uses `materials[0]`.
+    pub triangle_materials: Vec<u32>,
+}
+
+/// A view with a name, e.g. "closeup" and "stadium" for `teapot-in-stadium`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NamedView {
+    pub name: String,
+    pub view: View,
+}
+
+impl Scene {
+    /// The material of triangle `prim`.
+    pub fn material(&self, prim: u32) -> Material {
+        let index = self
+            .triangle_materials
+            .get(prim as usize)
+            .copied()
+            .unwrap_or(0);
+        self.materials
+            .get(index as usize)
+            .copied()
+            .unwrap_or_default()
+    }
 }
 
 /// Where a scene came from, enough to make it again.

@@ -28,7 +28,7 @@ fn bad_parameters_are_clear_errors() {
         ),
         (
             "sphere:colour=red",
-            "unknown parameter `colour` for sphere (known: triangles, radius)",
+            "unknown parameter `colour` for sphere (known: triangles, radius, view)",
         ),
         ("sphere:triangles", "`triangles` is not key=value"),
         (
@@ -166,17 +166,36 @@ fn default_views_see_the_object() {
 #[test]
 fn generator_list_describes_every_parameter() {
     let names: Vec<_> = generators().iter().map(|g| g.name).collect();
-    assert_eq!(names, ["sphere", "soup", "plane"]);
+    for expected in [
+        "sphere",
+        "soup",
+        "plane",
+        "teapot",
+        "teapot-in-stadium",
+        "grass",
+        "terrain",
+        "hair",
+        "city",
+    ] {
+        assert!(
+            names.contains(&expected),
+            "{expected} missing from {names:?}"
+        );
+    }
     for g in generators() {
         assert!(!g.description.is_empty());
-        for (key, meaning) in g.params {
-            assert!(meaning.contains("default"), "{}:{key}", g.name);
-            // Every listed key is accepted.
+        for p in g.params {
+            assert!(p.describe().contains("default"), "{}:{}", g.name, p.key);
+            // Every listed key is accepted at its default value.
+            let spec = format!("{}:{}={}", g.name, p.key, p.default);
             assert!(
-                generate(&format!("{}:{key}=1", g.name), 0).is_ok(),
-                "{}:{key}",
-                g.name
+                raybench_scenes::generators()
+                    .iter()
+                    .any(|x| x.name == g.name)
             );
+            if let Err(e) = generate(&spec, 0) {
+                assert!(!e.to_string().contains("unknown parameter"), "{spec}: {e}");
+            }
         }
     }
 }

@@ -53,12 +53,19 @@ pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
         loader_notes.push("UTF-8 byte-order mark skipped".to_owned());
     }
     loader_notes.extend(far_coordinate_note(&mesh));
+    let view = View::of_mesh(&mesh);
     Ok(Scene {
         name: scene_name(path),
         source: SceneSource::Obj {
             path: path.to_owned(),
         },
-        view: View::of_mesh(&mesh),
+        view,
+        views: vec![crate::NamedView {
+            name: "default".into(),
+            view,
+        }],
+        materials: vec![crate::Material::DEFAULT],
+        triangle_materials: Vec::new(),
         mesh: Arc::new(mesh),
         removed,
         loader_notes,
