@@ -41,6 +41,8 @@ pub struct RunSettings {
     pub tolerance: Tolerance,
     pub structures: Vec<String>,
     pub workloads: Vec<String>,
+    /// Recursion control of the `whitted` workload.
+    pub whitted: raybench_scenes::WhittedParams,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

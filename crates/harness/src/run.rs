@@ -11,7 +11,7 @@ use raybench_accel::Accel;
 use raybench_accel::compare::Tolerance;
 use raybench_embree::{Device, EmbreeParams, fpu};
 use raybench_geom::Ray;
-use raybench_scenes::{Scene, SuiteScene, SurfaceHit, Workload};
+use raybench_scenes::{Scene, SuiteScene, SurfaceHit, WhittedParams, Workload};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -164,6 +164,7 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
                 .iter()
                 .map(|w| w.name().to_string())
                 .collect(),
+            whitted: whitted_params(),
         },
         scenes: Vec::new(),
         results: Vec::new(),
@@ -294,6 +295,10 @@ impl<'a> SceneRun<'a> {
                     raybench_scenes::diffuse_rays(&s.mesh, &primary, &surface, seed),
                     None,
                 ),
+                Workload::Whitted => (
+                    whitted_rays(s, reference.as_ref(), &primary, &surface),
+                    None,
+                ),
             };
             check_rays(wl, &rays)?;
             let reference_answers = reference_answers(reference.as_ref(), &rays, wl.any_hit())?;
@@ -400,6 +405,45 @@ impl<'a> SceneRun<'a> {
             workloads,
         })
     }
+}
+
+/// Knobs of the recursive `whitted` workload, written into the report's run settings.
+pub fn whitted_params() -> WhittedParams {
+    WhittedParams::default()
+}
+
+/// Every generation of Whitted's recursion below the primary rays, traced with the reference so
+/// each structure later traces the identical set.
+fn whitted_rays(
+    scene: &Scene,
+    reference: &dyn Accel,
+    primary: &[Ray],
+    primary_hits: &[Option<SurfaceHit>],
+) -> Vec<Ray> {
+    let params = whitted_params();
+    let mut all = Vec::new();
+    let mut parents = primary.to_vec();
+    let mut weights = vec![1.0; primary.len()];
+    let mut hits = primary_hits.to_vec();
+    for depth in 1..=params.max_depth {
+        let (children, child_weights) =
+            raybench_scenes::whitted_children(scene, &parents, &weights, &hits, &params);
+        all.extend_from_slice(&children);
+        if depth == params.max_depth || children.is_empty() {
+            break;
+        }
+        hits = children.iter().map(|r| surface_hit(reference, r)).collect();
+        (parents, weights) = (children, child_weights);
+    }
+    all
+}
+
+fn surface_hit(accel: &dyn Accel, ray: &Ray) -> Option<SurfaceHit> {
+    accel.intersect(ray).map(|h| SurfaceHit {
+        prim: h.prim,
+        u: h.u,
+        v: h.v,
+    })
 }
 
 fn triangle_counts(s: &Scene) -> TriangleCounts {

@@ -53,7 +53,13 @@ fn bruteforce_and_every_embree_variant_agree() {
     assert!(report.errors.is_empty(), "{:?}", report.errors);
     assert_eq!(report.results.len(), 3 * structures.len());
     for r in &report.results {
-        assert_eq!(r.workloads.len(), 4, "{} on {}", r.structure, r.scene);
+        assert_eq!(
+            r.workloads.len(),
+            Workload::ALL.len(),
+            "{} on {}",
+            r.structure,
+            r.scene
+        );
         for w in &r.workloads {
             let v = &w.validation;
             assert_eq!(

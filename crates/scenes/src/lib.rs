@@ -20,11 +20,13 @@ mod workload;
 pub use error::SceneError;
 pub use generate::{GeneratorInfo, Kind, MAX_TRIANGLES, ParamInfo, generate, generators};
 pub use material::Material;
+pub use obj::export::{in_file_order, write_obj};
 pub use obj::load_obj;
 pub use suite::{Suite, SuiteScene, list_suites, load_suite, resolve_suite_scenes, suites_dir};
 pub use view::{Camera, View};
 pub use workload::{
-    SHADOW_T_MAX, SurfaceHit, Workload, diffuse_rays, primary_rays, random_rays, shadow_rays,
+    SHADOW_T_MAX, SurfaceHit, WhittedParams, Workload, diffuse_rays, primary_rays, random_rays,
+    shadow_rays, whitted_children,
 };
 
 use raybench_geom::{RemovedTriangles, TriangleMesh};
