@@ -98,7 +98,13 @@ pub fn classify(
         (None, None) => Verdict::BothMiss,
         (Some(a), None) | (None, Some(a)) => dispute(mesh, ray, a.prim, tol),
         (Some(a), Some(b)) => {
-            let scale = hit_scale(ray, a.t).max(hit_scale(ray, b.t));
+            // Positional error comes from every coordinate involved: the origin, the hit points
+            // and the triangles' vertices (a huge triangle passing near the origin rounds at
+            // the scale of its far vertices, not of the hit point).
+            let scale = hit_scale(ray, a.t)
+                .max(hit_scale(ray, b.t))
+                .max(triangle_scale(mesh, a.prim))
+                .max(triangle_scale(mesh, b.prim));
             let t = a.t.max(b.t);
             let window = |prim: u32| match prim_normal(mesh, prim) {
                 Some(n) => tol.t_tolerance(ray, t, scale, n),
@@ -141,6 +147,14 @@ pub fn classify_occlusion(
             }
         }
     }
+}
+
+fn triangle_scale(mesh: &TriangleMesh, prim: u32) -> f64 {
+    if prim as usize >= mesh.len() {
+        return 0.0;
+    }
+    let t = mesh.triangle(prim as usize);
+    t.v0.abs().max(t.v1.abs()).max(t.v2.abs()).max_element() as f64
 }
 
 fn prim_normal(mesh: &TriangleMesh, prim: u32) -> Option<Vec3> {

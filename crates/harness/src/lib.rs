@@ -7,5 +7,6 @@ pub mod measure;
 pub mod registry;
 pub mod report;
 pub mod run;
+pub mod scene_cmd;
 pub mod summary;
 pub mod validate;

@@ -1,12 +1,14 @@
-//! `raybench`: list what can be measured, and run measurements into a validated JSON report.
+//! `raybench`: list what can be measured, run measurements into a validated JSON report, and
+//! look at scenes (`raybench scene list|export|preview`).
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use raybench_harness::registry;
 use raybench_harness::run::{RunOptions, SceneRequest, run, suite_requests};
+use raybench_harness::scene_cmd;
 use raybench_harness::summary::summary_table;
 use raybench_scenes::Workload;
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -27,6 +29,51 @@ enum Command {
     List,
     /// Build, time, count and validate; write DIR/report.json.
     Run(RunArgs),
+    /// Look at scenes: list generators and views, export as OBJ, render a preview PNG.
+    #[command(subcommand)]
+    Scene(SceneCommand),
+}
+
+#[derive(Subcommand, Debug)]
+enum SceneCommand {
+    /// Every generator (parameters, named views) and the real OBJ scenes.
+    List,
+    /// Write a scene as a Wavefront OBJ file (loads back bit for bit).
+    Export(ExportArgs),
+    /// Render a shaded picture of a scene from its camera (traced with Embree) as a PNG.
+    Preview(PreviewArgs),
+}
+
+#[derive(Args, Debug)]
+struct ExportArgs {
+    /// A generator spec (teapot, grass:density=500) or an .obj path.
+    name: String,
+    /// Sets the generator's `triangles` parameter (an error for generators without one).
+    #[arg(long)]
+    triangles: Option<u64>,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// The OBJ file to write (atomically: a temporary file, then a rename).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct PreviewArgs {
+    /// A generator spec (teapot, grass:density=500) or an .obj path.
+    name: String,
+    /// A named view of the scene (see `raybench scene list`); default: the scene's default.
+    #[arg(long)]
+    view: Option<String>,
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// The PNG file to write (atomically: a temporary file, then a rename).
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -71,6 +118,15 @@ struct RunArgs {
 fn main() -> ExitCode {
     match real_main() {
         Ok(code) => code,
+        // `raybench list | head`: the reader left; nothing went wrong.
+        Err(e)
+            if e.chain().any(|c| {
+                c.downcast_ref::<std::io::Error>()
+                    .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            }) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("raybench: error: {e:#}");
             ExitCode::from(1)
@@ -82,7 +138,58 @@ fn real_main() -> Result<ExitCode> {
     match Cli::parse().command {
         Command::List => list().map(|_| ExitCode::SUCCESS),
         Command::Run(args) => run_command(args),
+        Command::Scene(cmd) => scene_command(cmd).map(|_| ExitCode::SUCCESS),
     }
+}
+
+fn scene_command(cmd: SceneCommand) -> Result<()> {
+    match cmd {
+        SceneCommand::List => scene_cmd::list(&mut std::io::stdout().lock())?,
+        SceneCommand::Export(a) => {
+            let s = scene_cmd::export(&a.name, a.triangles, a.seed, &a.out)?;
+            for note in &s.notes {
+                eprintln!("note: {note}");
+            }
+            if s.renumbered {
+                eprintln!(
+                    "note: vertices renumbered in order of first use ({} unused dropped), as \
+                     OBJ loaders read them back; triangle order is unchanged",
+                    s.unused_vertices
+                );
+            }
+            println!(
+                "{}: {} vertices, {} triangles ({}, seed {})",
+                a.out.display(),
+                s.vertices,
+                s.triangles,
+                s.spec,
+                a.seed
+            );
+        }
+        SceneCommand::Preview(a) => {
+            let start = std::time::Instant::now();
+            let s = scene_cmd::preview(
+                &a.name,
+                a.view.as_deref(),
+                a.width,
+                a.height,
+                a.seed,
+                &a.out,
+            )?;
+            println!(
+                "{}: {}×{} of {} ({} triangles), view `{}`, {:.0} % of pixels hit, {:.2} s",
+                a.out.display(),
+                a.width,
+                a.height,
+                s.scene,
+                s.triangles,
+                s.view,
+                s.coverage * 100.0,
+                start.elapsed().as_secs_f64()
+            );
+        }
+    }
+    Ok(())
 }
 
 fn list() -> Result<()> {
@@ -94,35 +201,12 @@ fn list() -> Result<()> {
             .unwrap_or_default();
         println!("  {:<24} {}{limit}", e.name, e.description);
     }
-    println!("\nScene generators (spec: name[:key=value,...]):");
-    for g in raybench_scenes::generators() {
-        println!("  {:<24} {}", g.name, g.description);
-        for p in g.params {
-            println!("  {:<24}   {}: {}", "", p.key, p.describe());
-        }
-    }
-    println!(
-        "  {:<24} {}",
-        "PATH.obj", "a Wavefront OBJ file (triangulated, positions only)"
-    );
-    let shared = raybench_scenes::suites_dir().join("../../shared/scenes");
-    match std::fs::read_dir(&shared) {
-        Ok(entries) => {
-            let mut files: Vec<PathBuf> = entries
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("obj")))
-                .collect();
-            files.sort();
-            println!("\nReal scenes ({}):", shared.display());
-            for f in files {
-                println!("  {}", f.display());
-            }
-        }
-        Err(_) => println!(
-            "\nReal scenes: {} is absent (suites skip those files with a note)",
-            shared.display()
-        ),
-    }
+    let mut out = std::io::stdout().lock();
+    writeln!(out)?;
+    scene_cmd::write_generators(&mut out, false)?;
+    writeln!(out)?;
+    scene_cmd::write_real_scenes(&mut out)?;
+    drop(out);
     println!("\nWorkloads:");
     for w in Workload::ALL {
         println!("  {:<24} {}", w.name(), w.description());
@@ -224,10 +308,57 @@ fn run_command(args: RunArgs) -> Result<ExitCode> {
 }
 
 fn specs(scenes: &[String]) -> Vec<SceneRequest> {
-    scenes
-        .iter()
-        .map(|s| SceneRequest::Spec(s.clone()))
+    join_spec_parameters(scenes)
+        .into_iter()
+        .map(SceneRequest::Spec)
         .collect()
+}
+
+/// `--scenes` is split on commas, and so are a spec's parameters: `offset:triangles=500,offset=1e7`
+/// arrives as `offset:triangles=500` and `offset=1e7`. A piece that is `key=value` (it has `=`
+/// but no `:` and is not an `.obj` path) continues the spec before it.
+fn join_spec_parameters(pieces: &[String]) -> Vec<String> {
+    let mut specs: Vec<String> = Vec::new();
+    for piece in pieces {
+        let continues = piece.contains('=')
+            && !piece.contains(':')
+            && !piece.to_ascii_lowercase().ends_with(".obj");
+        match specs.last_mut() {
+            Some(last) if continues => {
+                last.push(',');
+                last.push_str(piece);
+            }
+            _ => specs.push(piece.clone()),
+        }
+    }
+    specs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::join_spec_parameters;
+
+    #[test]
+    fn parameters_rejoin_their_spec() {
+        let pieces: Vec<String> = [
+            "offset:triangles=500",
+            "offset=1e7",
+            "sphere",
+            "soup:triangles=5",
+            "a/b=c.obj",
+        ]
+        .map(String::from)
+        .to_vec();
+        assert_eq!(
+            join_spec_parameters(&pieces),
+            [
+                "offset:triangles=500,offset=1e7",
+                "sphere",
+                "soup:triangles=5",
+                "a/b=c.obj"
+            ]
+        );
+    }
 }
 
 /// Explicit flags win, then the suite's value, then the default.

@@ -18,7 +18,9 @@ mod view;
 mod workload;
 
 pub use error::SceneError;
-pub use generate::{GeneratorInfo, Kind, MAX_TRIANGLES, ParamInfo, generate, generators};
+pub use generate::{
+    GeneratorInfo, Kind, MAX_TRIANGLES, ParamInfo, check_spec, generate, generators,
+};
 pub use material::Material;
 pub use obj::export::{in_file_order, write_obj};
 pub use obj::load_obj;

@@ -13,25 +13,85 @@ fn repository_suite(name: &str) -> (std::path::PathBuf, Suite) {
 }
 
 #[test]
-fn ci_and_default_parse_and_their_generated_scenes_resolve() {
-    for (file, rays, first_structure) in [
-        ("ci.json", 20_000, "bruteforce"),
-        ("default.json", 100_000, "embree-low"),
+fn every_suite_parses_and_names_only_valid_specs() {
+    let suites = list_suites().unwrap();
+    let names: Vec<_> = suites.iter().map(|(_, s)| s.name.as_str()).collect();
+    for expected in [
+        "ci",
+        "default",
+        "full",
+        "sweep-size",
+        "sweep-stadium",
+        "sweep-grass",
+        "adversarial",
+    ] {
+        assert!(names.contains(&expected), "{expected} missing: {names:?}");
+    }
+    for (path, suite) in &suites {
+        assert_eq!(
+            path.file_stem().unwrap().to_str().unwrap(),
+            suite.name,
+            "file name = suite name"
+        );
+        assert!(suite.rays > 0 && !suite.workloads.is_empty() && !suite.structures.is_empty());
+        assert!(
+            suite.structures.iter().any(|s| s.starts_with("embree-")),
+            "{}",
+            suite.name
+        );
+        for scene in &suite.scenes {
+            if let SuiteScene::Generated(spec) = scene {
+                raybench_scenes::check_spec(spec).unwrap_or_else(|e| panic!("{}: {e}", suite.name));
+            }
+        }
+    }
+}
+
+#[test]
+fn small_suites_generate_every_scene_with_its_view() {
+    for file in [
+        "ci.json",
+        "default.json",
+        "adversarial.json",
+        "sweep-stadium.json",
     ] {
         let (_, suite) = repository_suite(file);
-        assert_eq!(suite.rays, rays, "{file}");
-        assert_eq!(suite.workloads, Workload::ALL, "{file}");
-        assert_eq!(suite.structures[0], first_structure, "{file}");
-        assert!(
-            suite.structures.iter().any(|s| s == "embree-robust"),
-            "{file}"
-        );
         for scene in &suite.scenes {
             if let SuiteScene::Generated(spec) = scene {
                 generate(spec, 0).unwrap_or_else(|e| panic!("{file}: {e}"));
             }
         }
     }
+    let (_, ci) = repository_suite("ci.json");
+    assert_eq!(ci.workloads, Workload::ALL, "ci runs every workload");
+    assert_eq!(ci.structures[0], "bruteforce");
+}
+
+#[test]
+fn sweeps_span_what_they_claim() {
+    let specs = |file: &str| -> Vec<String> {
+        repository_suite(file)
+            .1
+            .scenes
+            .into_iter()
+            .filter_map(|s| match s {
+                SuiteScene::Generated(spec) => Some(spec),
+                SuiteScene::File { .. } => None,
+            })
+            .collect()
+    };
+    let size = specs("sweep-size.json");
+    assert_eq!(size.first().unwrap(), "teapot:triangles=1024");
+    assert_eq!(size.last().unwrap(), "teapot:triangles=4194304");
+    let stadium = specs("sweep-stadium.json");
+    assert_eq!(
+        (stadium[0].as_str(), stadium[4].as_str()),
+        (
+            "teapot-in-stadium:size_ratio=1e-1",
+            "teapot-in-stadium:size_ratio=1e-5"
+        )
+    );
+    assert_eq!(specs("sweep-grass.json").len(), 7);
 }
 
 #[test]
@@ -57,19 +117,6 @@ fn default_lists_every_shared_scene_as_optional() {
 }
 
 #[test]
-fn list_suites_finds_both_manifests() {
-    let names: Vec<_> = list_suites()
-        .unwrap()
-        .into_iter()
-        .map(|(_, s)| s.name)
-        .collect();
-    assert!(
-        names.contains(&"ci".to_owned()) && names.contains(&"default".to_owned()),
-        "{names:?}"
-    );
-}
-
-#[test]
 fn ci_suite_resolves_with_the_bunny_or_a_note() {
     let (path, suite) = repository_suite("ci.json");
     let (scenes, notes) = resolve_suite_scenes(&path, &suite, 0);
@@ -77,8 +124,13 @@ fn ci_suite_resolves_with_the_bunny_or_a_note() {
         .iter()
         .map(|s| s.as_ref().unwrap().name.clone())
         .collect();
+    let generated = suite
+        .scenes
+        .iter()
+        .filter(|s| matches!(s, SuiteScene::Generated(_)))
+        .count();
     assert_eq!(names[..3], ["sphere", "soup", "plane"]);
-    match names.get(3) {
+    match names.get(generated) {
         Some(bunny) => assert_eq!(bunny, "stanford-bunny"),
         None => {
             eprintln!("NOTE: the bunny was not loaded: {notes:?}");

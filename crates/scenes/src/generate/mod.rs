@@ -145,11 +145,21 @@ static GENERATORS: &[GeneratorInfo] = &[
     adversarial::ZERO_AREA_MIXED,
     adversarial::SINGLE_TRIANGLE,
     adversarial::EMPTY,
+    adversarial::IDENTICAL,
+    adversarial::FAN,
+    adversarial::HUGE_AND_SMALL,
+    adversarial::DEEP,
 ];
 
 /// The generators [`generate`] knows, with their parameters.
 pub fn generators() -> &'static [GeneratorInfo] {
     GENERATORS
+}
+
+/// Checks a spec (generator name, parameter names and values) without generating anything:
+/// cheap even for 10M-triangle specs. View names are checked when the scene is generated.
+pub fn check_spec(spec: &str) -> Result<(), SceneError> {
+    parse_spec(spec).map(|_| ())
 }
 
 /// Makes a procedural scene from a spec.

@@ -10,6 +10,7 @@
 //! 5. [`TriangleMesh::new`], which drops and counts triangles Embree would ignore, then "no
 //!    triangles" if nothing is left.
 
+pub mod export;
 mod scan;
 
 use crate::{Scene, SceneError, SceneSource, View};
