@@ -304,6 +304,30 @@ mod tests {
     }
 
     #[test]
+    fn huge_triangles_widen_the_window_even_near_the_origin() {
+        // A triangle with vertices 50 units out passes 0.2 below the origin: its plane is
+        // rounded at the scale of 50, so two answers 2e-5 apart in t agree. The same difference
+        // on the unit quad is a mismatch.
+        let huge = Triangle::new(
+            Vec3::new(-50.0, -50.0, 0.0),
+            Vec3::new(50.0, -50.0, 0.0),
+            Vec3::new(0.0, 50.0, 0.0),
+        );
+        let m = TriangleMesh::from_triangles(&[huge]).unwrap().0;
+        let tol = Tolerance::default();
+        let r = Ray::infinite(Vec3::new(0.0, 0.0, 0.2), Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(
+            classify(&m, &r, hit(0.2, 0), hit(0.20002, 0), &tol),
+            Verdict::WithinTolerance
+        );
+        let r = Ray::infinite(Vec3::new(0.7, 0.2, 0.2), Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(
+            classify(&quad(), &r, hit(0.2, 0), hit(0.20002, 0), &tol),
+            Verdict::Mismatch
+        );
+    }
+
+    #[test]
     fn clear_disagreements_are_mismatches() {
         let m = quad();
         let tol = Tolerance::default();
