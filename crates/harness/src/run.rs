@@ -47,6 +47,36 @@ impl SceneRequest {
             SceneRequest::File { path, .. } => path.display().to_string(),
         }
     }
+
+    /// The name the report uses for this scene: the spec as written (`teapot-in-stadium:view=
+    /// stadium`), or an OBJ file's name (`teapot.obj`), so a generated teapot and the teapot
+    /// file, or two views of one generator, never share a name.
+    fn report_name(&self) -> String {
+        let file_name = |p: &Path| p.file_name().map(|n| n.to_string_lossy().into_owned());
+        match self {
+            SceneRequest::Spec(s) if s.to_ascii_lowercase().ends_with(".obj") => {
+                file_name(Path::new(s)).unwrap_or_else(|| s.clone())
+            }
+            SceneRequest::Spec(s) => s.trim().to_string(),
+            SceneRequest::File { path, .. } => file_name(path).unwrap_or_else(|| self.label()),
+        }
+    }
+}
+
+/// `name`, or `name #2`, `name #3`, … if the run already has a scene of that name.
+fn unique_name(name: String, used: &mut std::collections::HashSet<String>) -> String {
+    let unique = (1..)
+        .map(|i| {
+            if i == 1 {
+                name.clone()
+            } else {
+                format!("{name} #{i}")
+            }
+        })
+        .find(|n| !used.contains(n))
+        .expect("some suffix is free");
+    used.insert(unique.clone());
+    unique
 }
 
 /// The scenes of a suite, resolved relative to the manifest's directory.
@@ -172,9 +202,10 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
         errors: Vec::new(),
     };
     let explicit = opts.suite.is_none();
+    let mut used_names = std::collections::HashSet::new();
     pool.install(|| {
         for request in scenes {
-            let scene = match load(request, opts.seed) {
+            let mut scene = match load(request, opts.seed) {
                 Ok(Some(s)) => s,
                 Ok(None) => {
                     let note = format!("skipped {}: optional scene file is absent", request.label());
@@ -189,6 +220,7 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
                     continue;
                 }
             };
+            scene.scene.name = unique_name(request.report_name(), &mut used_names);
             progress.step(format!("{}: generating workloads with {}", scene.scene.name, reference_entry.name));
             match SceneRun::prepare(&scene, opts, &reference_entry) {
                 Ok(sr) => {

@@ -108,8 +108,23 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
     assert_eq!(report.mismatches(), 0);
     assert!(report.errors.is_empty(), "{:?}", report.errors);
     let scenes: Vec<&str> = report.scenes.iter().map(|s| s.name.as_str()).collect();
-    for name in ["sphere", "soup", "plane"] {
-        assert!(scenes.contains(&name), "{scenes:?}");
+    for generator in [
+        "sphere",
+        "soup",
+        "plane",
+        "teapot",
+        "teapot-in-stadium",
+        "grass",
+        "terrain",
+        "hair",
+        "city",
+    ] {
+        assert!(
+            scenes
+                .iter()
+                .any(|s| s.split(':').next() == Some(generator)),
+            "{generator}: {scenes:?}"
+        );
     }
     if std::path::Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -117,12 +132,12 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
     ))
     .exists()
     {
-        assert!(scenes.contains(&"stanford-bunny"), "{scenes:?}");
+        assert!(scenes.contains(&"stanford-bunny.obj"), "{scenes:?}");
         assert!(
             report
                 .notes
                 .iter()
-                .any(|n| n.contains("bruteforce skipped on stanford-bunny")),
+                .any(|n| n.contains("bruteforce skipped on stanford-bunny.obj")),
             "{:?}",
             report.notes
         );

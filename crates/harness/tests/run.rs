@@ -215,6 +215,32 @@ fn a_broken_scene_is_an_error_in_the_report_not_a_crash() {
 }
 
 #[test]
+fn scenes_get_unique_report_names() {
+    let requests = [
+        "teapot:triangles=500",
+        "teapot:triangles=500",
+        "teapot:triangles=500,view=default",
+    ]
+    .map(|s| SceneRequest::Spec(s.into()))
+    .to_vec();
+    let report = run(&options(&["embree-medium"]), &requests).unwrap();
+    let names: Vec<&str> = report.scenes.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "teapot:triangles=500",
+            "teapot:triangles=500 #2",
+            "teapot:triangles=500,view=default"
+        ]
+    );
+    let result_names: Vec<&str> = report.results.iter().map(|r| r.scene.as_str()).collect();
+    assert_eq!(
+        result_names, names,
+        "results carry the same names, so ratios pair up correctly"
+    );
+}
+
+#[test]
 fn unknown_structure_is_a_clear_error() {
     let err = run(&options(&["bvh-nonexistent"]), &scenes())
         .unwrap_err()
