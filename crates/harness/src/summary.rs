@@ -22,9 +22,17 @@ fn sig(x: f64) -> String {
 pub fn summary_table(report: &Report) -> String {
     let workloads = &report.run.workloads;
     let mut out = String::new();
+    // The scene column fits the longest name (specs can be long), within reason.
+    let sw = report
+        .results
+        .iter()
+        .map(|r| r.scene.chars().count())
+        .max()
+        .unwrap_or(5)
+        .clamp(5, 48);
     let _ = write!(
         out,
-        "{:<22} {:<22} {:>10} {:>7}",
+        "{:<sw$} {:<22} {:>10} {:>7}",
         "scene", "structure", "build ms", "x ref"
     );
     for w in workloads {
@@ -34,8 +42,8 @@ pub fn summary_table(report: &Report) -> String {
     for r in &report.results {
         let _ = write!(
             out,
-            "{:<22} {:<22} {:>10} {:>7}",
-            truncate(&r.scene, 22),
+            "{:<sw$} {:<22} {:>10} {:>7}",
+            truncate(&r.scene, sw),
             truncate(&r.structure, 22),
             sig(r.build.median_ms),
             ratio(r.build_ratio_to_reference)
