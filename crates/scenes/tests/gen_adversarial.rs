@@ -1,7 +1,9 @@
 //! The adversarial generators: sizes, determinism, and the property each scene exists for.
 
+mod common;
+use common::{mesh_hash, scene, within_5_percent};
 use raybench_geom::{Aabb, DVec3, Ray, Vec3};
-use raybench_scenes::{Scene, generate, primary_rays, random_rays};
+use raybench_scenes::{generate, primary_rays, random_rays};
 use std::collections::{HashMap, HashSet};
 
 const ADVERSARIAL: [&str; 6] = [
@@ -12,31 +14,6 @@ const ADVERSARIAL: [&str; 6] = [
     "single-triangle",
     "empty",
 ];
-
-fn scene(spec: &str, seed: u64) -> Scene {
-    generate(spec, seed).unwrap_or_else(|e| panic!("{spec}: {e}"))
-}
-
-/// FNV-1a over every position's bits and every index.
-fn mesh_hash(s: &Scene) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let mut eat = |x: u32| {
-        for b in x.to_le_bytes() {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    };
-    for p in s.mesh.positions() {
-        p.to_array().iter().for_each(|c| eat(c.to_bits()));
-    }
-    for t in s.mesh.indices() {
-        t.iter().for_each(|&i| eat(i));
-    }
-    h
-}
-
-fn within_5_percent(made: usize, target: usize) -> bool {
-    made.abs_diff(target) * 20 <= target
-}
 
 fn normal_f64(v: [Vec3; 3]) -> DVec3 {
     let [a, b, c] = v.map(|p| p.as_dvec3());

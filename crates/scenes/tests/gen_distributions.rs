@@ -1,30 +1,11 @@
 //! The distribution generators (`terrain`, `grass`, `hair`, `city`): sizes, determinism,
 //! shape, the distribution property each one exists for, and views that see the geometry.
 
+mod common;
+use common::{error_of, mesh_hash, scene};
 use raybench_geom::{Aabb, Ray, Triangle, Vec3};
-use raybench_scenes::{Scene, generate, primary_rays};
+use raybench_scenes::{Scene, primary_rays};
 use std::collections::HashMap;
-
-fn scene(spec: &str, seed: u64) -> Scene {
-    generate(spec, seed).unwrap_or_else(|e| panic!("{spec}: {e}"))
-}
-
-/// FNV-1a over every vertex coordinate's bits and every index.
-fn geometry_hash(scene: &Scene) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let mut eat = |word: u32| {
-        for byte in word.to_le_bytes() {
-            h = (h ^ u64::from(byte)).wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    };
-    for p in scene.mesh.positions() {
-        p.to_array().into_iter().for_each(|c| eat(c.to_bits()));
-    }
-    for t in scene.mesh.indices() {
-        t.iter().for_each(|&i| eat(i));
-    }
-    h
-}
 
 fn assert_near_target(spec: &str, target: usize) {
     let n = scene(spec, 1).mesh.len();
@@ -95,13 +76,9 @@ fn same_seed_same_geometry_other_seed_other_geometry() {
         "hair:triangles=3000",
         "city:triangles=5000",
     ] {
-        let a = geometry_hash(&scene(spec, 7));
-        assert_eq!(a, geometry_hash(&scene(spec, 7)), "{spec}");
-        assert_ne!(
-            a,
-            geometry_hash(&scene(spec, 8)),
-            "{spec}: the seed is ignored"
-        );
+        let a = mesh_hash(&scene(spec, 7));
+        assert_eq!(a, mesh_hash(&scene(spec, 7)), "{spec}");
+        assert_ne!(a, mesh_hash(&scene(spec, 8)), "{spec}: the seed is ignored");
     }
 }
 
@@ -431,13 +408,6 @@ fn default_views_are_filled_with_geometry() {
         let (rays, _, _) = primary_rays(&s.view, &s.mesh.bounds(), 10_000);
         let coverage = hit_coverage(&s, &rays);
         assert!(coverage >= 0.5, "{spec}: only {coverage:.3} of rays hit");
-    }
-}
-
-fn error_of(spec: &str) -> String {
-    match generate(spec, 1) {
-        Ok(s) => panic!("`{spec}` was accepted ({} triangles)", s.mesh.len()),
-        Err(e) => e.to_string(),
     }
 }
 

@@ -1,42 +1,15 @@
 //! The `teapot` and `teapot-in-stadium` generators: sizes, determinism, bounds, closedness of
 //! the teapot, and what their views see (traced by brute force).
 
+mod common;
+use common::{mesh_hash, scene, within_5_percent};
 use raybench_geom::{Aabb, MollerTriangle, Ray};
 use raybench_scenes::{Material, Scene, Vec3, View, generate, primary_rays};
 use std::collections::HashMap;
 
-fn scene(spec: &str, seed: u64) -> Scene {
-    generate(spec, seed).unwrap_or_else(|e| panic!("{spec}: {e}"))
-}
-
-fn within_5_percent(got: usize, target: usize) -> bool {
-    got.abs_diff(target) * 20 <= target
-}
-
 /// Columns per patch for a target (see teapot.rs, `Tessellation`): `round(sqrt(target / 64))`.
 fn teapot_columns(target: f64) -> usize {
     ((target / 64.0).sqrt().round() as usize).max(1)
-}
-
-/// FNV-1a over every vertex coordinate's bits and every index.
-fn mesh_hash(s: &Scene) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let mut eat = |x: u32| {
-        for b in x.to_le_bytes() {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    };
-    for p in s.mesh.positions() {
-        for c in p.to_array() {
-            eat(c.to_bits());
-        }
-    }
-    for t in s.mesh.indices() {
-        for &i in t {
-            eat(i);
-        }
-    }
-    h
 }
 
 /// Triangles of the stadium (material 0) and of the teapot (material 1): the stadium's come

@@ -1,12 +1,7 @@
+mod common;
+use common::error_of;
 use raybench_scenes::{SceneSource, generate, generators, primary_rays};
 use std::collections::HashMap;
-
-fn error_of(spec: &str) -> String {
-    match generate(spec, 1) {
-        Ok(s) => panic!("`{spec}` was accepted ({} triangles)", s.mesh.len()),
-        Err(e) => e.to_string(),
-    }
-}
 
 #[test]
 fn bad_parameters_are_clear_errors() {

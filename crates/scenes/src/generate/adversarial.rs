@@ -420,35 +420,8 @@ fn sphere_grid(target: u64) -> (u32, u32) {
 fn offset_sphere(target: u64, offset: f64, radius: f64) -> Built {
     let (stacks, slices) = sphere_grid(target);
     let center = DVec3::ONE.normalize() * offset;
-    let vertex = |p: DVec3| (center + p * radius).as_vec3();
-    let mut positions = vec![vertex(DVec3::Y)];
-    for ring in 1..stacks {
-        let theta = std::f64::consts::PI * f64::from(ring) / f64::from(stacks);
-        for j in 0..slices {
-            let phi = std::f64::consts::TAU * f64::from(j) / f64::from(slices);
-            positions.push(vertex(DVec3::new(
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                theta.sin() * phi.sin(),
-            )));
-        }
-    }
-    positions.push(vertex(-DVec3::Y));
-    let south = positions.len() as u32 - 1;
-    let at = |ring: u32, j: u32| 1 + (ring - 1) * slices + j % slices;
-    let mut indices = Vec::with_capacity(2 * (slices * (stacks - 1)) as usize);
-    for j in 0..slices {
-        indices.push([0, at(1, j + 1), at(1, j)]);
-        indices.push([south, at(stacks - 1, j), at(stacks - 1, j + 1)]);
-    }
-    for ring in 1..stacks - 1 {
-        for j in 0..slices {
-            let (a, b) = (at(ring, j), at(ring, j + 1));
-            let (c, d) = (at(ring + 1, j), at(ring + 1, j + 1));
-            indices.push([a, b, d]);
-            indices.push([a, d, c]);
-        }
-    }
+    let (positions, indices) =
+        super::basic::uv_sphere(stacks, slices, |p| (center + p * radius).as_vec3());
     // From outside: at r / sin 20° the sphere subtends 40° of the 50° field of view. Placed in
     // f64 and rounded once, so at 1e7 (f32 spacing 0.5–1) the eye is as near the intended spot
     // as f32 allows; the default box-based view would back off to |centre|/1024 there.

@@ -3,7 +3,7 @@
 use super::{Built, GeneratorInfo, Kind, ParamInfo, triangles};
 use crate::rng::{self, SOUP_STREAM};
 use crate::{Camera, View};
-use raybench_geom::Vec3;
+use raybench_geom::{DVec3, Vec3};
 
 pub(super) const SPHERE: GeneratorInfo = GeneratorInfo {
     name: "sphere",
@@ -77,24 +77,36 @@ type Mesh = (Vec<Vec3>, Vec<[u32; 3]>, View);
 /// outside.
 fn sphere(target_triangles: u64, radius: f32) -> Mesh {
     let stacks = sphere_stacks(target_triangles);
-    let slices = 2 * stacks;
-    let mut positions = vec![Vec3::Y * radius];
+    let (positions, indices) = uv_sphere(stacks, 2 * stacks, |p| p.as_vec3() * radius);
+    (positions, indices, sphere_view(radius))
+}
+
+/// The UV-sphere mesh shared by `sphere` and the adversarial `offset` sphere: a pole vertex, then
+/// `stacks - 1` rings of `slices` vertices from north to south, then the other pole; `vertex`
+/// maps each exact unit-sphere point (f64) to its stored position, so callers choose how to
+/// scale, move and round. Rings are shared and the seam wraps by index, so every edge belongs
+/// to exactly two triangles; counter-clockwise seen from outside.
+pub(super) fn uv_sphere(
+    stacks: u32,
+    slices: u32,
+    vertex: impl Fn(DVec3) -> Vec3,
+) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut positions = vec![vertex(DVec3::Y)];
     for ring in 1..stacks {
-        let theta = std::f64::consts::PI * ring as f64 / stacks as f64;
+        let theta = std::f64::consts::PI * f64::from(ring) / f64::from(stacks);
         for j in 0..slices {
-            let phi = std::f64::consts::TAU * j as f64 / slices as f64;
-            let p = [
+            let phi = std::f64::consts::TAU * f64::from(j) / f64::from(slices);
+            positions.push(vertex(DVec3::new(
                 theta.sin() * phi.cos(),
                 theta.cos(),
                 theta.sin() * phi.sin(),
-            ];
-            positions.push(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) * radius);
+            )));
         }
     }
-    positions.push(-Vec3::Y * radius);
+    positions.push(vertex(-DVec3::Y));
     let south = positions.len() as u32 - 1;
     let at = |ring: u32, j: u32| 1 + (ring - 1) * slices + j % slices;
-    let mut indices = Vec::with_capacity((4 * stacks * (stacks - 1)) as usize);
+    let mut indices = Vec::with_capacity(2 * (slices * (stacks - 1)) as usize);
     for j in 0..slices {
         indices.push([0, at(1, j + 1), at(1, j)]);
         indices.push([south, at(stacks - 1, j), at(stacks - 1, j + 1)]);
@@ -107,7 +119,7 @@ fn sphere(target_triangles: u64, radius: f32) -> Mesh {
             indices.push([a, d, c]);
         }
     }
-    (positions, indices, sphere_view(radius))
+    (positions, indices)
 }
 
 /// Stacks `s` such that `4s(s-1)` is nearest `target`: `s ≈ (1 + sqrt(1 + target)) / 2`.

@@ -38,3 +38,37 @@ impl Drop for Fixtures {
 pub fn shared_scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes")
 }
+
+/// A generated scene, or a panic naming the spec.
+pub fn scene(spec: &str, seed: u64) -> raybench_scenes::Scene {
+    raybench_scenes::generate(spec, seed).unwrap_or_else(|e| panic!("{spec}: {e}"))
+}
+
+/// The error message of a spec that must be rejected.
+pub fn error_of(spec: &str) -> String {
+    match raybench_scenes::generate(spec, 1) {
+        Ok(s) => panic!("`{spec}` was accepted ({} triangles)", s.mesh.len()),
+        Err(e) => e.to_string(),
+    }
+}
+
+pub fn within_5_percent(made: usize, target: usize) -> bool {
+    made.abs_diff(target) * 20 <= target
+}
+
+/// FNV-1a over every position's bits and every index: equal hashes mean the same mesh.
+pub fn mesh_hash(s: &raybench_scenes::Scene) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |x: u32| {
+        for b in x.to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    };
+    for p in s.mesh.positions() {
+        p.to_array().iter().for_each(|c| eat(c.to_bits()));
+    }
+    for t in s.mesh.indices() {
+        t.iter().for_each(|&i| eat(i));
+    }
+    h
+}
