@@ -2,6 +2,7 @@
 //! (see README, "Adding a structure").
 
 use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
+use raybench_bvh::{Bvh, BvhParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
 use std::sync::Arc;
@@ -104,6 +105,30 @@ pub fn registry() -> Vec<StructureEntry> {
             |_| BruteForceParams {
                 triangle_test: TriangleTest::Watertight,
             },
+        ),
+        register::<Bvh>(
+            "bvh-median",
+            "binary BVH, object median on the longest axis (the baseline), ordered traversal",
+            None,
+            |_| BvhParams::median(),
+        ),
+        register::<Bvh>(
+            "bvh-sweep",
+            "binary BVH, full-sweep SAH (every split position, per axis), ordered traversal",
+            None,
+            |_| BvhParams::sweep(),
+        ),
+        register::<Bvh>(
+            "bvh-binned",
+            "binary BVH, binned SAH (Wald 2007, 16 bins), ordered traversal",
+            None,
+            |_| BvhParams::binned(),
+        ),
+        register::<Bvh>(
+            "bvh-binned-unordered",
+            "the bvh-binned tree traversed in fixed child order (what ordering saves)",
+            None,
+            |_| BvhParams::binned_unordered(),
         ),
         register::<EmbreeScene>(
             "embree-low",

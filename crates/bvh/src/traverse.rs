@@ -1,0 +1,130 @@
+//! The one traversal loop, for closest hit and any hit, ordered and unordered, counted and not.
+
+use crate::{Bvh, MAX_DEPTH, Node};
+use raybench_accel::{CounterSink, Hit};
+use raybench_geom::{Ray, TriHit, max_keep, min_keep};
+
+/// What the slab test needs of a ray, with each axis's near/far plane choice made once.
+struct SlabRay {
+    origin: [f32; 3],
+    inv_dir: [f32; 3],
+    negative: [bool; 3],
+}
+
+impl SlabRay {
+    fn new(ray: &Ray) -> SlabRay {
+        let inv = ray.inv_dir();
+        SlabRay {
+            origin: ray.origin().to_array(),
+            inv_dir: inv.to_array(),
+            // By sign bit, so -0 (inv = -inf) picks the far plane first (bug class B3).
+            negative: [
+                inv.x.is_sign_negative(),
+                inv.y.is_sign_negative(),
+                inv.z.is_sign_negative(),
+            ],
+        }
+    }
+
+    /// Entry distance into `node`'s box within `[t_min, t_max]`, or `None`. The only possible
+    /// NaN (`0 * inf`, origin on a face plane with a zero direction component) is ignored by
+    /// `max_keep`/`min_keep`, which is the right answer for a closed box (bug class B1).
+    #[inline(always)]
+    fn enter(&self, node: &Node, t_min: f32, t_max: f32) -> Option<f32> {
+        let (mut t0, mut t1) = (t_min, t_max);
+        for a in 0..3 {
+            let (near, far) = if self.negative[a] {
+                (node.max[a], node.min[a])
+            } else {
+                (node.min[a], node.max[a])
+            };
+            t0 = max_keep(t0, (near - self.origin[a]) * self.inv_dir[a]);
+            t1 = min_keep(t1, (far - self.origin[a]) * self.inv_dir[a]);
+        }
+        (t0 <= t1).then_some(t0)
+    }
+}
+
+impl Bvh {
+    /// Iterative depth-first walk with a fixed stack of (node, entry t) — one entry per level
+    /// at most, and the builder caps the depth at [`MAX_DEPTH`], so it cannot overflow.
+    /// `ORDERED`: descend into the nearer child first and drop popped entries that start beyond
+    /// the closest hit so far. `ANY_HIT`: return at the first hit.
+    pub(crate) fn trace<const ANY_HIT: bool, const ORDERED: bool, C: CounterSink>(
+        &self,
+        ray: &Ray,
+        c: &mut C,
+    ) -> Option<Hit> {
+        let root = self.nodes.first()?;
+        let slab = SlabRay::new(ray);
+        let t_min = ray.t_min();
+        let mut best_t = ray.t_max();
+        let mut best: Option<(usize, TriHit)> = None;
+        slab.enter(root, t_min, best_t)?;
+        let mut stack = [(0u32, 0f32); MAX_DEPTH];
+        let mut sp = 0;
+        let mut node = 0usize;
+        'walk: loop {
+            let n = &self.nodes[node];
+            if n.is_leaf() {
+                c.leaf();
+                let first = n.index as usize;
+                for i in first..first + n.count as usize {
+                    c.prim_tests(1);
+                    if let Some(h) = self.triangles[i].intersect(&ray.with_t_max(best_t)) {
+                        best_t = h.t;
+                        best = Some((i, h));
+                        if ANY_HIT {
+                            break 'walk;
+                        }
+                    }
+                }
+            } else {
+                c.node();
+                let (a, b) = (node + 1, n.index as usize);
+                let ta = slab.enter(&self.nodes[a], t_min, best_t);
+                let tb = slab.enter(&self.nodes[b], t_min, best_t);
+                match (ta, tb) {
+                    (Some(x), Some(y)) => {
+                        let (near, far, t_far) = if ORDERED && y < x {
+                            (b, a, x)
+                        } else {
+                            (a, b, y)
+                        };
+                        stack[sp] = (far as u32, t_far);
+                        sp += 1;
+                        node = near;
+                        continue;
+                    }
+                    (Some(_), None) => {
+                        node = a;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        node = b;
+                        continue;
+                    }
+                    (None, None) => {}
+                }
+            }
+            loop {
+                if sp == 0 {
+                    break 'walk;
+                }
+                sp -= 1;
+                let (next, t_entry) = stack[sp];
+                if ORDERED && t_entry > best_t {
+                    continue; // starts beyond the closest hit: nothing in it can be closer
+                }
+                node = next as usize;
+                break;
+            }
+        }
+        best.map(|(i, h)| Hit {
+            t: h.t,
+            prim: self.prim_ids[i],
+            u: h.u,
+            v: h.v,
+        })
+    }
+}

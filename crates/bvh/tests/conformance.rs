@@ -1,0 +1,47 @@
+//! The shared conformance suite for every BVH variant, `validate()` after every build.
+
+use raybench_bvh::{Bvh, BvhParams};
+use raybench_testkit::conformance;
+
+fn check(params: BvhParams) {
+    let counts = conformance::<Bvh>(&params, &|bvh, mesh| bvh.validate(mesh));
+    assert_eq!(counts.mismatch, 0);
+    assert!(
+        counts.exact > 10_000,
+        "the suite must exercise hits: {counts:?}"
+    );
+}
+
+#[test]
+fn median_conforms() {
+    check(BvhParams::median());
+}
+
+#[test]
+fn sweep_conforms() {
+    check(BvhParams::sweep());
+}
+
+#[test]
+fn binned_conforms() {
+    check(BvhParams::binned());
+}
+
+#[test]
+fn binned_unordered_conforms() {
+    check(BvhParams::binned_unordered());
+}
+
+#[test]
+fn tiny_leaves_and_coarse_bins_conform() {
+    // Extreme knobs exercise deep trees and forced splits.
+    check(BvhParams {
+        max_leaf_size: 1,
+        bins: 2,
+        ..BvhParams::binned()
+    });
+    check(BvhParams {
+        max_leaf_size: 1,
+        ..BvhParams::sweep()
+    });
+}
