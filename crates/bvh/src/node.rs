@@ -9,10 +9,11 @@ pub const MAX_DEPTH: usize = 64;
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Node {
-    pub min: [f32; 3],
+    /// `[min, max]`: indexable by a ray's per-axis sign, so the slab test picks its near and
+    /// far planes without a branch.
+    pub bounds: [[f32; 3]; 2],
     /// Interior: index of the second child. Leaf: offset of the first triangle.
     pub index: u32,
-    pub max: [f32; 3],
     /// Triangles in the leaf; 0 for an interior node.
     pub count: u32,
 }
@@ -22,18 +23,16 @@ const _: () = assert!(std::mem::size_of::<Node>() == 32);
 impl Node {
     pub fn leaf(bounds: &Aabb, first: u32, count: u32) -> Node {
         Node {
-            min: bounds.min.to_array(),
+            bounds: [bounds.min.to_array(), bounds.max.to_array()],
             index: first,
-            max: bounds.max.to_array(),
             count,
         }
     }
 
     pub fn interior(bounds: &Aabb, second_child: u32) -> Node {
         Node {
-            min: bounds.min.to_array(),
+            bounds: [bounds.min.to_array(), bounds.max.to_array()],
             index: second_child,
-            max: bounds.max.to_array(),
             count: 0,
         }
     }
@@ -45,6 +44,6 @@ impl Node {
 
     #[inline(always)]
     pub fn bounds(&self) -> Aabb {
-        Aabb::new(self.min.into(), self.max.into())
+        Aabb::new(self.bounds[0].into(), self.bounds[1].into())
     }
 }

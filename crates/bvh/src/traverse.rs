@@ -8,7 +8,10 @@ use raybench_geom::{Ray, TriHit, max_keep, min_keep};
 struct SlabRay {
     origin: [f32; 3],
     inv_dir: [f32; 3],
-    negative: [bool; 3],
+    /// Per axis, 1 when the direction's sign bit is set (so -0, whose inverse is -inf, counts
+    /// as negative: bug class B3): the index of the near plane in `Node::bounds`, and
+    /// `1 - near` the far one.
+    near: [usize; 3],
 }
 
 impl SlabRay {
@@ -17,12 +20,7 @@ impl SlabRay {
         SlabRay {
             origin: ray.origin().to_array(),
             inv_dir: inv.to_array(),
-            // By sign bit, so -0 (inv = -inf) picks the far plane first (bug class B3).
-            negative: [
-                inv.x.is_sign_negative(),
-                inv.y.is_sign_negative(),
-                inv.z.is_sign_negative(),
-            ],
+            near: [inv.x, inv.y, inv.z].map(|x| x.is_sign_negative() as usize),
         }
     }
 
@@ -33,11 +31,8 @@ impl SlabRay {
     fn enter(&self, node: &Node, t_min: f32, t_max: f32) -> Option<f32> {
         let (mut t0, mut t1) = (t_min, t_max);
         for a in 0..3 {
-            let (near, far) = if self.negative[a] {
-                (node.max[a], node.min[a])
-            } else {
-                (node.min[a], node.max[a])
-            };
+            let near = node.bounds[self.near[a]][a];
+            let far = node.bounds[1 - self.near[a]][a];
             t0 = max_keep(t0, (near - self.origin[a]) * self.inv_dir[a]);
             t1 = min_keep(t1, (far - self.origin[a]) * self.inv_dir[a]);
         }

@@ -122,7 +122,7 @@ mod tests {
     #[test]
     fn a_child_outside_its_parent_is_caught() {
         let (mut bvh, mesh) = built();
-        bvh.nodes[1].max[0] += 10.0;
+        bvh.nodes[1].bounds[1][0] += 10.0;
         assert!(
             bvh.validate(&mesh)
                 .unwrap_err()
@@ -141,7 +141,7 @@ mod tests {
     fn a_leaf_box_missing_its_triangle_is_caught() {
         let (mut bvh, mesh) = built();
         let leaf = bvh.nodes.iter().position(|n| n.is_leaf()).unwrap();
-        bvh.nodes[leaf].min = bvh.nodes[leaf].max;
+        bvh.nodes[leaf].bounds[0] = bvh.nodes[leaf].bounds[1];
         let err = bvh.validate(&mesh).unwrap_err();
         assert!(
             err.contains("does not contain") || err.contains("not inside"),
