@@ -38,9 +38,10 @@ pub enum Builder {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BvhParams {
     pub builder: Builder,
-    /// Bins per axis for the binned builder. 16: measured against 8 and 32 on the bunny,
-    /// Sponza, conference and dragon (README, "BVH"): 8 raised the SAH cost by up to 1.7 %,
-    /// 32 lowered it by at most 0.4 % at 1.3× the build time.
+    /// Bins per axis for the binned builder (never more than the node has triangles). 32:
+    /// measured against 8 and 16 on the bunny, Sponza, conference and dragon (1 thread,
+    /// 2026-11-21): relative to 16 bins, 8 raised the SAH cost by 1.3–4.0 % and 32 lowered it
+    /// by 0.04–4.7 % (conference the most) for 1.03–1.08× the build time.
     pub bins: u32,
     /// SAH cost of stepping through a node, for the builder's split decisions.
     pub traversal_cost: f32,
@@ -65,7 +66,7 @@ impl BvhParams {
     pub fn binned() -> BvhParams {
         BvhParams {
             builder: Builder::Binned,
-            bins: 16,
+            bins: 32,
             traversal_cost: 1.0,
             intersection_cost: 1.0,
             max_leaf_size: 8,

@@ -120,7 +120,7 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<Bvh>(
             "bvh-binned",
-            "binary BVH, binned SAH (Wald 2007, 16 bins), ordered traversal",
+            "binary BVH, binned SAH (Wald 2007, 32 bins), ordered traversal",
             None,
             |_| BvhParams::binned(),
         ),
