@@ -45,3 +45,12 @@ fn tiny_leaves_and_coarse_bins_conform() {
         ..BvhParams::sweep()
     });
 }
+
+#[test]
+fn binned_conforms_on_the_shared_scenes() {
+    let checked =
+        raybench_testkit::conformance_on_shared_scenes::<Bvh>(&BvhParams::binned(), &|b, m| {
+            b.validate(m)
+        });
+    eprintln!("real scenes checked: {checked}");
+}

@@ -144,3 +144,50 @@ pub fn mesh(positions: Vec<raybench_geom::Vec3>, indices: Vec<[u32; 3]>) -> Arc<
             .0,
     )
 }
+
+/// The real scenes of `../shared/scenes` (relative to the repository), when the folder exists.
+pub fn shared_scenes_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes")
+}
+
+/// Conformance on every real OBJ scene present: build, `validate()`, and a few hundred seeded
+/// random and triangle-aimed rays against brute force (few rays: brute force on 331k triangles
+/// is slow). Prints plainly, and returns 0, when the folder is absent; otherwise returns how
+/// many scenes were checked.
+pub fn conformance_on_shared_scenes<A: Accel>(
+    params: &A::Params,
+    validate: Validator<'_, A>,
+) -> usize {
+    let dir = shared_scenes_dir();
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        eprintln!(
+            "NOT RUN: {} is absent, so the real-scene conformance check did not run",
+            dir.display()
+        );
+        return 0;
+    };
+    let mut files: Vec<_> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .collect();
+    files.sort();
+    for path in &files {
+        let scene = raybench_scenes::load_obj(path).unwrap_or_else(|e| panic!("{e}"));
+        let seed = 0x5eed_0005;
+        let mut rays = random_rays_in(&scene.mesh.bounds().enlarged(0.05), 150, seed);
+        rays.extend(centroid_rays(&scene.mesh, 150, seed));
+        let case = Case {
+            name: path.display().to_string(),
+            seed,
+            mesh: scene.mesh,
+            rays,
+        };
+        let counts = check_case::<A>(&case, params, validate).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            counts.exact + counts.within_tolerance > 0,
+            "{}: no hits checked",
+            case.name
+        );
+    }
+    files.len()
+}
