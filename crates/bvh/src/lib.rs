@@ -17,7 +17,7 @@ mod node;
 mod traverse;
 mod validate;
 
-pub use node::{MAX_DEPTH, Node};
+pub use node::{ChildRef, MAX_DEPTH, Node};
 
 use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount};
 use raybench_geom::{MollerTriangle, Ray, TriangleMesh};
@@ -116,6 +116,9 @@ pub struct Bvh {
     name: String,
     params: BvhParams,
     nodes: Vec<Node>,
+    /// The whole tree: an interior node, or for tiny meshes a single leaf.
+    root: ChildRef,
+    root_bounds: raybench_geom::Aabb,
     triangles: Vec<MollerTriangle>,
     prim_ids: Vec<u32>,
     stats: BuildStats,
@@ -160,6 +163,8 @@ impl Accel for Bvh {
             params: params.clone(),
             stats: flat.stats,
             nodes: flat.nodes,
+            root: flat.root,
+            root_bounds: flat.root_bounds,
             triangles,
             prim_ids: flat.prim_ids,
         })

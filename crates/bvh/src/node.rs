@@ -4,46 +4,41 @@ use raybench_geom::Aabb;
 /// the traversal stack (one entry per level) can never overflow.
 pub const MAX_DEPTH: usize = 64;
 
-/// One node of the flattened tree, 32 bytes: the box, and either the index of the second child
-/// (`count == 0`; the first child is the next node) or a leaf's first triangle and count.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C)]
-pub struct Node {
-    /// `[min, max]`: indexable by a ray's per-axis sign, so the slab test picks its near and
-    /// far planes without a branch.
-    pub bounds: [[f32; 3]; 2],
-    /// Interior: index of the second child. Leaf: offset of the first triangle.
+/// A reference to a subtree: an interior node (`count == 0`, `index` into the node array) or a
+/// leaf (`count` triangles from `index` in the triangle array).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ChildRef {
     pub index: u32,
-    /// Triangles in the leaf; 0 for an interior node.
     pub count: u32,
 }
 
-const _: () = assert!(std::mem::size_of::<Node>() == 32);
-
-impl Node {
-    pub fn leaf(bounds: &Aabb, first: u32, count: u32) -> Node {
-        Node {
-            bounds: [bounds.min.to_array(), bounds.max.to_array()],
-            index: first,
-            count,
-        }
-    }
-
-    pub fn interior(bounds: &Aabb, second_child: u32) -> Node {
-        Node {
-            bounds: [bounds.min.to_array(), bounds.max.to_array()],
-            index: second_child,
-            count: 0,
-        }
-    }
-
+impl ChildRef {
     #[inline(always)]
     pub fn is_leaf(&self) -> bool {
         self.count > 0
     }
+}
 
-    #[inline(always)]
-    pub fn bounds(&self) -> Aabb {
-        Aabb::new(self.bounds[0].into(), self.bounds[1].into())
+/// One interior node, 64 bytes and 64-byte aligned (one cache line): the boxes of both children
+/// and where each child is. Keeping the children's boxes in the parent means one fetch serves
+/// both box tests; a child node is only fetched when the ray descends into it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub struct Node {
+    /// `[child][min or max][axis]`: indexable by a ray's per-axis sign, so the slab test picks
+    /// its near and far planes without a branch.
+    pub bounds: [[[f32; 3]; 2]; 2],
+    pub child: [ChildRef; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<Node>() == 64);
+
+impl Node {
+    pub fn child_bounds(&self, i: usize) -> Aabb {
+        Aabb::new(self.bounds[i][0].into(), self.bounds[i][1].into())
     }
+}
+
+pub(crate) fn corners(b: &Aabb) -> [[f32; 3]; 2] {
+    [b.min.to_array(), b.max.to_array()]
 }

@@ -1,6 +1,6 @@
 //! The one traversal loop, for closest hit and any hit, ordered and unordered, counted and not.
 
-use crate::{Bvh, MAX_DEPTH, Node};
+use crate::{Bvh, ChildRef, MAX_DEPTH};
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::{Ray, TriHit, max_keep, min_keep};
 
@@ -9,7 +9,7 @@ struct SlabRay {
     origin: [f32; 3],
     inv_dir: [f32; 3],
     /// Per axis, 1 when the direction's sign bit is set (so -0, whose inverse is -inf, counts
-    /// as negative: bug class B3): the index of the near plane in `Node::bounds`, and
+    /// as negative: bug class B3): the index of the near plane in a box `[min, max]`, and
     /// `1 - near` the far one.
     near: [usize; 3],
 }
@@ -24,94 +24,97 @@ impl SlabRay {
         }
     }
 
-    /// Entry distance into `node`'s box within `[t_min, t_max]`, or `None`. The only possible
-    /// NaN (`0 * inf`, origin on a face plane with a zero direction component) is ignored by
-    /// `max_keep`/`min_keep`, which is the right answer for a closed box (bug class B1).
+    /// Entry distance into the box `[min, max]` within `[t_min, t_max]`, or `None`. The only
+    /// possible NaN (`0 * inf`, origin on a face plane with a zero direction component) is
+    /// ignored by `max_keep`/`min_keep`, which is the right answer for a closed box (B1).
     #[inline(always)]
-    fn enter(&self, node: &Node, t_min: f32, t_max: f32) -> Option<f32> {
+    fn enter(&self, b: &[[f32; 3]; 2], t_min: f32, t_max: f32) -> Option<f32> {
         let (mut t0, mut t1) = (t_min, t_max);
         for a in 0..3 {
-            let near = node.bounds[self.near[a]][a];
-            let far = node.bounds[1 - self.near[a]][a];
-            t0 = max_keep(t0, (near - self.origin[a]) * self.inv_dir[a]);
-            t1 = min_keep(t1, (far - self.origin[a]) * self.inv_dir[a]);
+            t0 = max_keep(t0, (b[self.near[a]][a] - self.origin[a]) * self.inv_dir[a]);
+            t1 = min_keep(
+                t1,
+                (b[1 - self.near[a]][a] - self.origin[a]) * self.inv_dir[a],
+            );
         }
         (t0 <= t1).then_some(t0)
     }
 }
 
 impl Bvh {
-    /// Iterative depth-first walk with a fixed stack of (node, entry t) — one entry per level
-    /// at most, and the builder caps the depth at [`MAX_DEPTH`], so it cannot overflow.
-    /// `ORDERED`: descend into the nearer child first and drop popped entries that start beyond
-    /// the closest hit so far. `ANY_HIT`: return at the first hit.
+    /// Iterative depth-first walk with a fixed stack of (subtree, entry t) — one entry per
+    /// level at most, and the builder caps the depth at [`MAX_DEPTH`], so it cannot overflow.
+    /// `ORDERED`: visit the nearer child first and drop popped entries that start beyond the
+    /// closest hit so far. `ANY_HIT`: return at the first hit.
     pub(crate) fn trace<const ANY_HIT: bool, const ORDERED: bool, C: CounterSink>(
         &self,
         ray: &Ray,
         c: &mut C,
     ) -> Option<Hit> {
-        let root = self.nodes.first()?;
+        if self.triangles.is_empty() {
+            return None;
+        }
         let slab = SlabRay::new(ray);
         let t_min = ray.t_min();
         let mut best_t = ray.t_max();
         let mut best: Option<(usize, TriHit)> = None;
-        slab.enter(root, t_min, best_t)?;
-        let mut stack = [(0u32, 0f32); MAX_DEPTH];
+        let root = [
+            self.root_bounds.min.to_array(),
+            self.root_bounds.max.to_array(),
+        ];
+        slab.enter(&root, t_min, best_t)?;
+        let mut stack = [(ChildRef::default(), 0f32); MAX_DEPTH];
         let mut sp = 0;
-        let mut node = 0usize;
+        let mut next = Some(self.root);
         'walk: loop {
-            let n = &self.nodes[node];
-            if n.is_leaf() {
-                c.leaf();
-                let first = n.index as usize;
-                for i in first..first + n.count as usize {
-                    c.prim_tests(1);
-                    if let Some(h) = self.triangles[i].intersect(&ray.with_t_max(best_t)) {
-                        best_t = h.t;
-                        best = Some((i, h));
-                        if ANY_HIT {
-                            break 'walk;
+            // Descend: interior nodes until both children are missed or a leaf is reached.
+            while let Some(r) = next.take() {
+                if r.is_leaf() {
+                    c.leaf();
+                    let first = r.index as usize;
+                    for i in first..first + r.count as usize {
+                        c.prim_tests(1);
+                        if let Some(h) = self.triangles[i].intersect(&ray.with_t_max(best_t)) {
+                            best_t = h.t;
+                            best = Some((i, h));
+                            if ANY_HIT {
+                                break 'walk;
+                            }
                         }
                     }
+                    break;
                 }
-            } else {
                 c.node();
-                let (a, b) = (node + 1, n.index as usize);
-                let ta = slab.enter(&self.nodes[a], t_min, best_t);
-                let tb = slab.enter(&self.nodes[b], t_min, best_t);
-                match (ta, tb) {
+                let n = &self.nodes[r.index as usize];
+                let ta = slab.enter(&n.bounds[0], t_min, best_t);
+                let tb = slab.enter(&n.bounds[1], t_min, best_t);
+                next = match (ta, tb) {
                     (Some(x), Some(y)) => {
                         let (near, far, t_far) = if ORDERED && y < x {
-                            (b, a, x)
+                            (1, 0, x)
                         } else {
-                            (a, b, y)
+                            (0, 1, y)
                         };
-                        stack[sp] = (far as u32, t_far);
+                        stack[sp] = (n.child[far], t_far);
                         sp += 1;
-                        node = near;
-                        continue;
+                        Some(n.child[near])
                     }
-                    (Some(_), None) => {
-                        node = a;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        node = b;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
+                    (Some(_), None) => Some(n.child[0]),
+                    (None, Some(_)) => Some(n.child[1]),
+                    (None, None) => None,
+                };
             }
+            // Pop the next subtree worth visiting.
             loop {
                 if sp == 0 {
                     break 'walk;
                 }
                 sp -= 1;
-                let (next, t_entry) = stack[sp];
+                let (r, t_entry) = stack[sp];
                 if ORDERED && t_entry > best_t {
                     continue; // starts beyond the closest hit: nothing in it can be closer
                 }
-                node = next as usize;
+                next = Some(r);
                 break;
             }
         }

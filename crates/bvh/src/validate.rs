@@ -1,6 +1,6 @@
 //! The invariants of a built BVH, checked by tests after every build.
 
-use crate::{Bvh, MAX_DEPTH};
+use crate::{Bvh, ChildRef, MAX_DEPTH};
 use raybench_geom::TriangleMesh;
 
 /// Every child box inside its parent's, every leaf box containing its triangles, leaf ranges
@@ -29,72 +29,94 @@ pub(crate) fn validate(bvh: &Bvh, mesh: &TriangleMesh) -> Result<(), String> {
             return Err(format!("triangle slot {i} is not mesh triangle {id}"));
         }
     }
-    if bvh.nodes.is_empty() {
-        return if n == 0 {
+    if n == 0 {
+        return if bvh.nodes.is_empty() {
             Ok(())
         } else {
-            Err("no nodes for a non-empty mesh".into())
+            Err("nodes for an empty mesh".into())
         };
     }
     let mut covered = 0usize;
-    walk(bvh, mesh, 0, 0, &mut covered)?;
+    let mut interior = 0usize;
+    walk(
+        bvh,
+        mesh,
+        bvh.root,
+        &bvh.root_bounds,
+        0,
+        &mut covered,
+        &mut interior,
+    )?;
     if covered != n {
         return Err(format!("leaves hold {covered} triangles, the mesh has {n}"));
+    }
+    if interior != bvh.nodes.len() {
+        return Err(format!("{interior} nodes reachable of {}", bvh.nodes.len()));
     }
     Ok(())
 }
 
-/// Depth-first from `node`: checks the subtree and returns the index after it.
+/// Depth-first from `r`, whose box is `bounds`: leaves contain their triangles and tile the
+/// triangle array in order; children's boxes lie inside their parent's.
 fn walk(
     bvh: &Bvh,
     mesh: &TriangleMesh,
-    node: usize,
+    r: ChildRef,
+    bounds: &raybench_geom::Aabb,
     depth: usize,
     covered: &mut usize,
-) -> Result<usize, String> {
+    interior: &mut usize,
+) -> Result<(), String> {
     if depth >= MAX_DEPTH {
-        return Err(format!(
-            "node {node} at depth {depth} exceeds the stack size {MAX_DEPTH}"
-        ));
+        return Err(format!("depth {depth} exceeds the stack size {MAX_DEPTH}"));
     }
-    let n = bvh
-        .nodes
-        .get(node)
-        .ok_or(format!("node index {node} out of range"))?;
-    let bounds = n.bounds();
-    if n.is_leaf() {
-        let first = n.index as usize;
+    if r.is_leaf() {
+        let first = r.index as usize;
         if first != *covered {
             return Err(format!(
-                "leaf {node} starts at {first}, expected {covered} (depth-first order)"
+                "leaf at {first}, expected {covered} (depth-first order)"
             ));
         }
-        for i in first..first + n.count as usize {
+        for i in first..first + r.count as usize {
             let id = *bvh
                 .prim_ids
                 .get(i)
-                .ok_or(format!("leaf {node} runs past the triangles"))?;
+                .ok_or(format!("leaf at {first} runs past the triangles"))?;
             if !bounds.contains_box(&mesh.triangle(id as usize).bounds()) {
-                return Err(format!("leaf {node} does not contain triangle {id}"));
+                return Err(format!("leaf box does not contain triangle {id}"));
             }
         }
-        *covered += n.count as usize;
-        return Ok(node + 1);
+        *covered += r.count as usize;
+        return Ok(());
     }
-    let first_child = node + 1;
-    let after_first = walk(bvh, mesh, first_child, depth + 1, covered)?;
-    if n.index as usize != after_first {
+    let at = r.index as usize;
+    if at != *interior {
         return Err(format!(
-            "node {node}'s second child is {} but its first subtree ends at {after_first}",
-            n.index
+            "node {at} reached out of depth-first order (expected {})",
+            *interior
         ));
     }
-    for child in [first_child, after_first] {
-        if !bounds.contains_box(&bvh.nodes[child].bounds()) {
-            return Err(format!("child {child} is not inside its parent {node}"));
+    *interior += 1;
+    let node = bvh
+        .nodes
+        .get(at)
+        .ok_or(format!("node index {at} out of range"))?;
+    for i in 0..2 {
+        let child = node.child_bounds(i);
+        if !bounds.contains_box(&child) {
+            return Err(format!("child {i} of node {at} is not inside its parent"));
         }
+        walk(
+            bvh,
+            mesh,
+            node.child[i],
+            &child,
+            depth + 1,
+            covered,
+            interior,
+        )?;
     }
-    walk(bvh, mesh, after_first, depth + 1, covered)
+    Ok(())
 }
 
 #[cfg(test)]
@@ -122,7 +144,7 @@ mod tests {
     #[test]
     fn a_child_outside_its_parent_is_caught() {
         let (mut bvh, mesh) = built();
-        bvh.nodes[1].bounds[1][0] += 10.0;
+        bvh.nodes[1].bounds[0][1][0] += 10.0;
         assert!(
             bvh.validate(&mesh)
                 .unwrap_err()
@@ -140,8 +162,11 @@ mod tests {
     #[test]
     fn a_leaf_box_missing_its_triangle_is_caught() {
         let (mut bvh, mesh) = built();
-        let leaf = bvh.nodes.iter().position(|n| n.is_leaf()).unwrap();
-        bvh.nodes[leaf].bounds[0] = bvh.nodes[leaf].bounds[1];
+        let (node, side) = (0..bvh.nodes.len())
+            .flat_map(|n| [(n, 0), (n, 1)])
+            .find(|&(n, i)| bvh.nodes[n].child[i].is_leaf())
+            .unwrap();
+        bvh.nodes[node].bounds[side][0] = bvh.nodes[node].bounds[side][1];
         let err = bvh.validate(&mesh).unwrap_err();
         assert!(
             err.contains("does not contain") || err.contains("not inside"),
@@ -152,7 +177,7 @@ mod tests {
     #[test]
     fn a_wrong_second_child_is_caught() {
         let (mut bvh, mesh) = built();
-        bvh.nodes[0].index += 1;
+        bvh.nodes[0].child[1].index += 1;
         assert!(bvh.validate(&mesh).is_err());
     }
 }

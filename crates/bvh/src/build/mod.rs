@@ -12,7 +12,7 @@
 //! becomes one, while a larger range is cut in half in its current order — all centroids
 //! equal, say — so recursion always shrinks the range and always ends.
 
-use crate::node::{MAX_DEPTH, Node};
+use crate::node::{ChildRef, MAX_DEPTH, Node, corners};
 use crate::{Builder, BvhParams};
 use raybench_accel::{BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use raybench_geom::{Aabb, TriangleMesh, Vec3};
@@ -47,6 +47,8 @@ pub(crate) struct Flat {
     pub nodes: Vec<Node>,
     pub prim_ids: Vec<u32>,
     pub stats: BuildStats,
+    pub root: ChildRef,
+    pub root_bounds: Aabb,
 }
 
 pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Flat {
@@ -66,19 +68,23 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Flat {
             nodes: Vec::new(),
             prim_ids: ids,
             stats: BuildStats::default(),
+            root: ChildRef::default(),
+            root_bounds: Aabb::EMPTY,
         };
     }
     let (bounds, centroids) = range_bounds(&infos, &ids);
-    let root = build_range(&infos, &mut ids, Ranged { bounds, centroids }, 0, 0, params);
-    let mut flat = Flat {
-        nodes: Vec::with_capacity(2 * mesh.len()),
-        prim_ids: ids,
-        stats: BuildStats::default(),
-    };
+    let tree = build_range(&infos, &mut ids, Ranged { bounds, centroids }, 0, 0, params);
+    let mut nodes = Vec::with_capacity(mesh.len());
+    let root = flatten(&tree, &mut nodes);
     let mut shape = Shape::default();
-    flatten(&root, 0, &mut flat.nodes, &mut shape);
-    flat.stats = shape.stats(&flat.nodes);
-    flat
+    shape.visit(&tree, 0, bounds.surface_area());
+    Flat {
+        nodes,
+        prim_ids: ids,
+        stats: shape.stats(),
+        root,
+        root_bounds: bounds,
+    }
 }
 
 /// Bounds of the triangles and of their centroids.
@@ -400,83 +406,96 @@ fn partition_in_place(ids: &mut [u32], left: impl Fn(&u32) -> bool) -> usize {
     mid
 }
 
-/// Facts gathered while flattening, turned into [`BuildStats`].
+/// Facts gathered from the build tree, turned into [`BuildStats`].
 #[derive(Default)]
 struct Shape {
+    nodes: u64,
     leaves: u64,
+    refs: u64,
     max_depth: u32,
     leaf_depth_sum: u64,
     max_leaf_size: u32,
+    /// SAH cost with the constants shared by every structure (None for a zero-area root).
+    sah: Option<f64>,
 }
 
 impl Shape {
-    fn stats(&self, nodes: &[Node]) -> BuildStats {
-        let refs: u64 = nodes
-            .iter()
-            .filter(|n| n.is_leaf())
-            .map(|n| n.count as u64)
-            .sum();
+    /// Each node's traversal cost and each leaf's triangle tests, weighted by the probability
+    /// that a random ray through the root box also crosses the node's box (area ratio).
+    fn visit(&mut self, node: &BuildNode, depth: u32, root_area: f64) {
+        self.max_depth = self.max_depth.max(depth);
+        let (bounds, work) = match node {
+            BuildNode::Leaf { bounds, count, .. } => {
+                self.leaves += 1;
+                self.refs += *count as u64;
+                self.leaf_depth_sum += depth as u64;
+                self.max_leaf_size = self.max_leaf_size.max(*count);
+                (bounds, SAH_INTERSECTION_COST * *count as f64)
+            }
+            BuildNode::Interior { bounds, children } => {
+                self.nodes += 1;
+                for c in children.iter() {
+                    self.visit(c, depth + 1, root_area);
+                }
+                (bounds, SAH_TRAVERSAL_COST)
+            }
+        };
+        if root_area > 0.0 {
+            *self.sah.get_or_insert(0.0) += work * bounds.surface_area() / root_area;
+        }
+    }
+
+    fn stats(&self) -> BuildStats {
         let mut extra = std::collections::BTreeMap::new();
         let leaves = self.leaves.max(1) as f64;
         extra.insert(
             "mean_leaf_depth".into(),
             self.leaf_depth_sum as f64 / leaves,
         );
-        extra.insert("mean_leaf_size".into(), refs as f64 / leaves);
+        extra.insert("mean_leaf_size".into(), self.refs as f64 / leaves);
         extra.insert("max_leaf_size".into(), self.max_leaf_size as f64);
         BuildStats {
-            nodes: nodes.len() as u64,
+            // Interior nodes plus leaves, as every structure counts them.
+            nodes: self.nodes + self.leaves,
             leaves: self.leaves,
             max_depth: self.max_depth,
-            refs,
-            sah_cost: sah_cost(nodes),
+            refs: self.refs,
+            sah_cost: self.sah,
             extra,
         }
     }
 }
 
-/// SAH cost of the whole tree with the constants shared by every structure: each node's
-/// traversal cost and each leaf's triangle tests, weighted by the probability that a random
-/// ray through the root box also crosses the node's box (area ratio).
-pub fn sah_cost(nodes: &[Node]) -> Option<f64> {
-    let root = nodes.first()?.bounds().surface_area();
-    if root <= 0.0 {
-        return None;
-    }
-    let cost = nodes
-        .iter()
-        .map(|n| {
-            let work = if n.is_leaf() {
-                SAH_INTERSECTION_COST * n.count as f64
-            } else {
-                SAH_TRAVERSAL_COST
+/// Depth-first: an interior node is stored before its subtrees; returns the reference to it.
+fn flatten(node: &BuildNode, out: &mut Vec<Node>) -> ChildRef {
+    match node {
+        BuildNode::Leaf { first, count, .. } => ChildRef {
+            index: *first,
+            count: *count,
+        },
+        BuildNode::Interior { children, .. } => {
+            let at = out.len();
+            out.push(Node {
+                bounds: [[[0.0; 3]; 2]; 2],
+                child: [ChildRef::default(); 2],
+            });
+            let refs = [flatten(&children[0], out), flatten(&children[1], out)];
+            out[at] = Node {
+                bounds: [corners(children[0].bounds()), corners(children[1].bounds())],
+                child: refs,
             };
-            work * n.bounds().surface_area() / root
-        })
-        .sum();
-    Some(cost)
+            ChildRef {
+                index: at as u32,
+                count: 0,
+            }
+        }
+    }
 }
 
-/// Depth-first: a node's first child follows it, the second's index is stored in the node.
-fn flatten(node: &BuildNode, depth: u32, out: &mut Vec<Node>, shape: &mut Shape) {
-    shape.max_depth = shape.max_depth.max(depth);
-    match node {
-        BuildNode::Leaf {
-            bounds,
-            first,
-            count,
-        } => {
-            shape.leaves += 1;
-            shape.leaf_depth_sum += depth as u64;
-            shape.max_leaf_size = shape.max_leaf_size.max(*count);
-            out.push(Node::leaf(bounds, *first, *count));
-        }
-        BuildNode::Interior { bounds, children } => {
-            let at = out.len();
-            out.push(Node::interior(bounds, 0));
-            flatten(&children[0], depth + 1, out, shape);
-            out[at].index = out.len() as u32;
-            flatten(&children[1], depth + 1, out, shape);
+impl BuildNode {
+    fn bounds(&self) -> &Aabb {
+        match self {
+            BuildNode::Leaf { bounds, .. } | BuildNode::Interior { bounds, .. } => bounds,
         }
     }
 }
