@@ -1,9 +1,9 @@
 //! raybench-bvh: binary bounding volume hierarchies over triangles.
 //!
 //! Built in a convenient shape (a boxed tree over one in-place-partitioned primitive index
-//! array, see [`build`]), then flattened into a depth-first array of 32-byte nodes with the
-//! triangles reordered into leaf order, and traversed from that flat form
-//! ([`traverse`]). Four registered variants share the code:
+//! array, see [`build`]), then flattened into a depth-first array of 64-byte nodes (each
+//! holding both children's boxes) with the triangles reordered into leaf order, and traversed
+//! from that flat form ([`traverse`]). Four registered variants share the code:
 //!
 //! | name | builder | traversal |
 //! |---|---|---|

@@ -14,7 +14,10 @@ use plotters::prelude::{BitMapBackend, DrawingBackend};
 use raybench_accel::Accel;
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{Aabb, Ray, Vec3};
-use raybench_scenes::{GeneratorInfo, Kind, SHADOW_T_MAX, Scene, SceneSource, View};
+use raybench_scenes::{
+    GeneratorInfo, Kind, SHADOW_T_MAX, Scene, SceneSource, SurfaceHit, SurfacePoint, View,
+    surface_point,
+};
 use rayon::prelude::*;
 use std::io::{self, Write};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -338,9 +341,6 @@ pub fn background(y: u32, height: u32) -> [u8; 3] {
 const ALBEDO: [f32; 3] = [0.85, 0.62, 0.42];
 /// Light every surface gets, lit or not, so shadowed and back-lit parts stay visible.
 const AMBIENT: f32 = 0.12;
-/// Relative offset of the shadow ray's origin off the surface: workload.rs's `ORIGIN_OFFSET`
-/// (2^-16 of the hit triangle's largest coordinate), for the same reasons.
-const SHADOW_ORIGIN_OFFSET: f32 = 1.0 / 65536.0;
 
 /// Renders `scene` from `view` into `width × height` RGB pixels, row-major from the top-left.
 ///
@@ -379,25 +379,15 @@ fn shade(
     ray: &Ray,
     hit: raybench_accel::Hit,
 ) -> [u8; 3] {
-    let tri = mesh.triangle(hit.prim as usize);
-    // f64 cross product: f32 overflows or underflows for very large or tiny triangles.
-    let (a, b, c) = (tri.v0.as_dvec3(), tri.v1.as_dvec3(), tri.v2.as_dvec3());
-    let normal = (b - a)
-        .cross(c - a)
-        .try_normalize()
-        .map_or(-ray.dir().normalize_or_zero(), |n| n.as_vec3());
-    let normal = if normal.dot(ray.dir()) > 0.0 {
-        -normal
-    } else {
-        normal
+    let surface = SurfaceHit {
+        prim: hit.prim,
+        u: hit.u,
+        v: hit.v,
     };
-    let scale = tri
-        .v0
-        .abs()
-        .max(tri.v1.abs())
-        .max(tri.v2.abs())
-        .max_element();
-    let origin = tri.point_at(hit.u, hit.v) + normal * (scale * SHADOW_ORIGIN_OFFSET);
+    // Zero-area triangles are never hit, so a point without a normal is only ambient light.
+    let Some(SurfacePoint { origin, normal, .. }) = surface_point(mesh, ray, &surface) else {
+        return ALBEDO.map(|albedo| ((albedo * AMBIENT).powf(1.0 / 2.2) * 255.0).round() as u8);
+    };
     let to_light = light - origin;
     let lambert = normal.dot(to_light.normalize_or_zero()).max(0.0);
     let lit = lambert > 0.0 && !accel.occluded(&Ray::new(origin, to_light, 0.0, SHADOW_T_MAX));

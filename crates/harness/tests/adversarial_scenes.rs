@@ -2,9 +2,11 @@
 //! preset, every workload, checked against the reference. Each structure must build and agree
 //! (0 mismatches), or the report must carry an error naming the scene; never a panic.
 
+mod common;
+
 use raybench_harness::report::Report;
 use raybench_harness::run::{RunOptions, SceneRequest, run};
-use raybench_scenes::{Workload, generators};
+use raybench_scenes::generators;
 
 const STRUCTURES: [&str; 6] = [
     "bruteforce",
@@ -46,18 +48,10 @@ const IF_REGISTERED: [&str; 5] = [
 
 fn options() -> RunOptions {
     RunOptions {
-        suite: None,
-        scenes: vec![],
-        structures: STRUCTURES.iter().map(|s| s.to_string()).collect(),
-        workloads: Workload::ALL.to_vec(),
         rays: 2_000,
         threads: 2,
-        reference: "embree-medium".into(),
         seed: 11,
-        build_runs: 1,
-        trace_runs: 1,
-        ftz_daz: false,
-        progress: false,
+        ..common::options(&STRUCTURES)
     }
 }
 

@@ -2,26 +2,12 @@
 //! determinism of rays and counters.
 
 use raybench_harness::report::Report;
-use raybench_harness::run::{RunOptions, SceneRequest, run};
+mod common;
+
+use common::options;
+use raybench_harness::run::{SceneRequest, run};
 use raybench_scenes::Workload;
 use std::path::PathBuf;
-
-fn options(structures: &[&str]) -> RunOptions {
-    RunOptions {
-        suite: None,
-        scenes: vec![],
-        structures: structures.iter().map(|s| s.to_string()).collect(),
-        workloads: Workload::ALL.to_vec(),
-        rays: 3000,
-        threads: 1,
-        reference: "embree-medium".into(),
-        seed: 7,
-        build_runs: 1,
-        trace_runs: 1,
-        ftz_daz: false,
-        progress: false,
-    }
-}
 
 fn scenes() -> Vec<SceneRequest> {
     [

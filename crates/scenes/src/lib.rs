@@ -27,8 +27,8 @@ pub use obj::load_obj;
 pub use suite::{Suite, SuiteScene, list_suites, load_suite, resolve_suite_scenes, suites_dir};
 pub use view::{Camera, View};
 pub use workload::{
-    SHADOW_T_MAX, SurfaceHit, WhittedParams, Workload, diffuse_rays, primary_rays, random_rays,
-    shadow_rays, whitted_children,
+    SHADOW_T_MAX, SurfaceHit, SurfacePoint, WhittedParams, Workload, diffuse_rays, primary_rays,
+    random_rays, shadow_rays, surface_point, whitted_children,
 };
 
 use raybench_geom::{RemovedTriangles, TriangleMesh};

@@ -224,17 +224,25 @@ const ORIGIN_OFFSET: f32 = 1.0 / 65536.0;
 pub const SHADOW_T_MAX: f32 = 1.0 - 1.0 / 16_777_216.0;
 
 /// Where a secondary ray starts and which side of the surface it is on.
-struct SurfacePoint {
-    origin: Vec3,
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    /// The hit point moved off the surface towards the incoming ray (see the module docs).
+    pub origin: Vec3,
     /// The same point moved the same distance to the other side (where refracted rays start).
-    behind: Vec3,
+    pub behind: Vec3,
     /// Unit normal on the side the primary ray came from.
-    normal: Vec3,
+    pub normal: Vec3,
     /// True when the ray arrived on the front (counter-clockwise) side: it is entering.
-    front: bool,
+    pub front: bool,
 }
 
-fn surface_point(mesh: &TriangleMesh, incoming: &Ray, hit: &SurfaceHit) -> Option<SurfacePoint> {
+/// The surface point of `hit` as every secondary ray (and the preview's shading) uses it;
+/// `None` for a triangle with no usable normal (zero area, or a cross product that overflows).
+pub fn surface_point(
+    mesh: &TriangleMesh,
+    incoming: &Ray,
+    hit: &SurfaceHit,
+) -> Option<SurfacePoint> {
     let tri = mesh.triangle(hit.prim as usize);
     // The cross product in f64: f32 overflows for triangles near 1e19 and underflows for tiny ones.
     let (a, b, c) = (tri.v0.as_dvec3(), tri.v1.as_dvec3(), tri.v2.as_dvec3());

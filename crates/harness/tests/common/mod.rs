@@ -1,0 +1,24 @@
+//! Shared by the harness's integration tests.
+#![allow(dead_code)]
+
+use raybench_harness::run::RunOptions;
+use raybench_scenes::Workload;
+
+/// A quick, explicit run: every workload, 3000 rays, one thread, one build and one trace pass,
+/// against embree-medium. Tests override what they need with struct update syntax.
+pub fn options(structures: &[&str]) -> RunOptions {
+    RunOptions {
+        suite: None,
+        scenes: vec![],
+        structures: structures.iter().map(|s| s.to_string()).collect(),
+        workloads: Workload::ALL.to_vec(),
+        rays: 3000,
+        threads: 1,
+        reference: "embree-medium".into(),
+        seed: 7,
+        build_runs: 1,
+        trace_runs: 1,
+        ftz_daz: false,
+        progress: false,
+    }
+}
