@@ -130,6 +130,9 @@ pub fn registry() -> Vec<StructureEntry> {
             None,
             |_| BvhParams::binned_unordered(),
         ),
+        // k-d trees (raybench-kdtree) go here.
+        // Uniform grids (raybench-grid) go here.
+        // Octrees (raybench-octree) go here.
         register::<EmbreeScene>(
             "embree-low",
             "Embree 3 BVH, RTC_BUILD_QUALITY_LOW (fast build)",

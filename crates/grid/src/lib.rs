@@ -1,0 +1,1 @@
+//! raybench-grid (in progress).

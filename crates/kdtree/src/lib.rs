@@ -1,0 +1,1 @@
+//! raybench-kdtree (in progress).

@@ -1,0 +1,1 @@
+//! raybench-octree (in progress).
