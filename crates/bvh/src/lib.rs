@@ -1,8 +1,10 @@
 //! raybench-bvh: binary bounding volume hierarchies over triangles.
 //!
-//! Built in a convenient shape (a boxed tree over one in-place-partitioned primitive index
-//! array, see [`build`]), then flattened into a depth-first array of 64-byte nodes (each
-//! holding both children's boxes) with the triangles reordered into leaf order, and traversed
+//! Built over one array of primitive records partitioned in place (each node owns a range;
+//! see [`build`]), sequential subtrees written straight into depth-first node vectors that are
+//! joined once; the result is a depth-first array of 64-byte nodes (each holding both
+//! children's boxes, laid out for one SIMD slab test per axis) with the triangles reordered into
+//! leaf order, and traversed
 //! from that flat form ([`traverse`]). Four registered variants share the code:
 //!
 //! | name | builder | traversal |
@@ -14,6 +16,7 @@
 
 pub mod build;
 mod node;
+mod simd;
 mod traverse;
 mod validate;
 
@@ -152,7 +155,7 @@ impl Accel for Bvh {
                 "bins >= 2 and max_leaf_size >= 1 (got {params:?})"
             )));
         }
-        let flat = build::build(&mesh, params);
+        let flat = build::build(&mesh, params)?;
         let triangles = flat
             .prim_ids
             .iter()

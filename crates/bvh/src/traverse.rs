@@ -1,6 +1,7 @@
 //! The one traversal loop, for closest hit and any hit, ordered and unordered, counted and not.
 
-use crate::{Bvh, ChildRef, MAX_DEPTH};
+use crate::simd::F4;
+use crate::{Bvh, ChildRef, MAX_DEPTH, Node};
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::{Ray, TriHit, max_keep, min_keep};
 
@@ -12,15 +13,23 @@ struct SlabRay {
     /// as negative: bug class B3): the index of the near plane in a box `[min, max]`, and
     /// `1 - near` the far one.
     near: [usize; 3],
+    /// The same ray in SIMD lanes for [`SlabRay::enter_children`]: the origin splatted, and
+    /// the inverse direction as `[inv, inv, -inv, -inv]`, so the far distances come out
+    /// negated and one `max` per axis tightens entries and exits alike.
+    origin4: [F4; 3],
+    inv4: [F4; 3],
 }
 
 impl SlabRay {
     fn new(ray: &Ray) -> SlabRay {
-        let inv = ray.inv_dir();
+        let inv = ray.inv_dir().to_array();
+        let origin = ray.origin().to_array();
         SlabRay {
-            origin: ray.origin().to_array(),
-            inv_dir: inv.to_array(),
-            near: [inv.x, inv.y, inv.z].map(|x| x.is_sign_negative() as usize),
+            origin,
+            inv_dir: inv,
+            near: inv.map(|x| x.is_sign_negative() as usize),
+            origin4: origin.map(F4::splat),
+            inv4: inv.map(|x| F4::new(x, x, -x, -x)),
         }
     }
 
@@ -38,6 +47,28 @@ impl SlabRay {
             );
         }
         (t0 <= t1).then_some(t0)
+    }
+
+    /// Both children of `n` at once, the same arithmetic as [`SlabRay::enter`] lane for lane:
+    /// lanes `[entry 0, entry 1, -exit 0, -exit 1]` start at `[t_min, t_min, -t_max, -t_max]`
+    /// and each axis raises them with its near (or negated far) plane distances; a NaN lane is
+    /// ignored because `max_keep` keeps the accumulator. Returns a mask (bit `i`: child `i` is
+    /// hit) and the lanes, whose first two are the entry distances.
+    #[inline(always)]
+    fn enter_children(&self, n: &Node, t_min: f32, t_max: f32) -> (u32, [f32; 4]) {
+        let mut acc = F4::new(t_min, t_min, -t_max, -t_max);
+        for a in 0..3 {
+            let planes = F4::load(&n.planes[a]);
+            // Near planes first: for a negative direction the max planes are met first.
+            let planes = if self.near[a] == 1 {
+                planes.swap_halves()
+            } else {
+                planes
+            };
+            acc = planes.sub(self.origin4[a]).mul(self.inv4[a]).max_keep(acc);
+        }
+        let mask = acc.le_mask(acc.swap_halves().neg()) & 0b11;
+        (mask, acc.to_array())
     }
 }
 
@@ -72,11 +103,12 @@ impl Bvh {
                 if r.is_leaf() {
                     c.leaf();
                     let first = r.index as usize;
-                    for i in first..first + r.count as usize {
+                    let leaf = &self.triangles[first..first + r.count as usize];
+                    for (k, tri) in leaf.iter().enumerate() {
                         c.prim_tests(1);
-                        if let Some(h) = self.triangles[i].intersect(&ray.with_t_max(best_t)) {
+                        if let Some(h) = tri.intersect(&ray.with_t_max(best_t)) {
                             best_t = h.t;
-                            best = Some((i, h));
+                            best = Some((first + k, h));
                             if ANY_HIT {
                                 break 'walk;
                             }
@@ -86,22 +118,21 @@ impl Bvh {
                 }
                 c.node();
                 let n = &self.nodes[r.index as usize];
-                let ta = slab.enter(&n.bounds[0], t_min, best_t);
-                let tb = slab.enter(&n.bounds[1], t_min, best_t);
-                next = match (ta, tb) {
-                    (Some(x), Some(y)) => {
-                        let (near, far, t_far) = if ORDERED && y < x {
-                            (1, 0, x)
+                let (hit, t) = slab.enter_children(n, t_min, best_t);
+                next = match hit {
+                    0b11 => {
+                        let (near, far, t_far) = if ORDERED && t[1] < t[0] {
+                            (1, 0, t[0])
                         } else {
-                            (0, 1, y)
+                            (0, 1, t[1])
                         };
                         stack[sp] = (n.child[far], t_far);
                         sp += 1;
                         Some(n.child[near])
                     }
-                    (Some(_), None) => Some(n.child[0]),
-                    (None, Some(_)) => Some(n.child[1]),
-                    (None, None) => None,
+                    0b01 => Some(n.child[0]),
+                    0b10 => Some(n.child[1]),
+                    _ => None,
                 };
             }
             // Pop the next subtree worth visiting.

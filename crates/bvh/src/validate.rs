@@ -144,7 +144,9 @@ mod tests {
     #[test]
     fn a_child_outside_its_parent_is_caught() {
         let (mut bvh, mesh) = built();
-        bvh.nodes[1].bounds[0][1][0] += 10.0;
+        let mut b = bvh.nodes[1].child_bounds(0);
+        b.max.x += 10.0;
+        bvh.nodes[1].set_child_bounds(0, &b);
         assert!(
             bvh.validate(&mesh)
                 .unwrap_err()
@@ -166,7 +168,8 @@ mod tests {
             .flat_map(|n| [(n, 0), (n, 1)])
             .find(|&(n, i)| bvh.nodes[n].child[i].is_leaf())
             .unwrap();
-        bvh.nodes[node].bounds[side][0] = bvh.nodes[node].bounds[side][1];
+        let b = bvh.nodes[node].child_bounds(side);
+        bvh.nodes[node].set_child_bounds(side, &raybench_geom::Aabb::new(b.max, b.max));
         let err = bvh.validate(&mesh).unwrap_err();
         assert!(
             err.contains("does not contain") || err.contains("not inside"),
