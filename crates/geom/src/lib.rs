@@ -15,6 +15,7 @@ mod aabb;
 mod mesh;
 mod ray;
 mod triangle;
+pub mod tribox;
 
 pub use aabb::Aabb;
 pub use glam::{DVec3, Vec3};

@@ -5,6 +5,9 @@ use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
 use raybench_bvh::{Bvh, BvhParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
+use raybench_grid::{Grid, GridParams};
+use raybench_kdtree::{KdParams, KdTree};
+use raybench_octree::{Octree, OctreeParams};
 use std::sync::Arc;
 
 /// What a build may depend on besides the mesh.
@@ -130,9 +133,42 @@ pub fn registry() -> Vec<StructureEntry> {
             None,
             |_| BvhParams::binned_unordered(),
         ),
-        // k-d trees (raybench-kdtree) go here.
-        // Uniform grids (raybench-grid) go here.
-        // Octrees (raybench-octree) go here.
+        register::<KdTree>(
+            "kd-sah",
+            "k-d tree, SAH with perfect splits in O(N log N) (Wald–Havran 2006), early exit, mailbox",
+            None,
+            |_| KdParams::sah(),
+        ),
+        register::<KdTree>(
+            "kd-median",
+            "k-d tree, spatial median with round-robin axes (the baseline), early exit, mailbox",
+            None,
+            |_| KdParams::median(),
+        ),
+        register::<Grid>(
+            "grid-coarse",
+            "uniform grid, λ = 1/8 cells per triangle (too few cells), exact insertion, 3D-DDA",
+            None,
+            |_| GridParams::coarse(),
+        ),
+        register::<Grid>(
+            "grid",
+            "uniform grid, λ = 1 cell per triangle (Cleary–Wyvill), exact insertion, 3D-DDA, mailboxing, 4-wide tests",
+            None,
+            |_| GridParams::default(),
+        ),
+        register::<Grid>(
+            "grid-fine",
+            "uniform grid, λ = 8 cells per triangle (too many cells), exact insertion, 3D-DDA",
+            None,
+            |_| GridParams::fine(),
+        ),
+        register::<Octree>(
+            "octree",
+            "octree, MAX_OBJ 8, MAX_DEPTH 20, exact insertion, front-to-back traversal with mailboxing",
+            None,
+            |_| OctreeParams::default(),
+        ),
         register::<EmbreeScene>(
             "embree-low",
             "Embree 3 BVH, RTC_BUILD_QUALITY_LOW (fast build)",

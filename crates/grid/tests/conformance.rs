@@ -1,0 +1,255 @@
+//! The shared conformance suite for every grid variant, `validate()` after every build, plus
+//! rays aimed at the grid's own geometry: axis-parallel, starting inside, exactly along cell
+//! planes, edges and corners.
+
+use raybench_accel::{Accel, BuildError};
+use raybench_geom::{Ray, Triangle, TriangleMesh, Vec3};
+use raybench_grid::{Grid, GridParams};
+use raybench_testkit::{Case, check_case, conformance, seeded_rng};
+use std::sync::Arc;
+
+fn check(params: GridParams) {
+    let counts = conformance::<Grid>(&params, &|g, mesh| g.validate(mesh));
+    assert_eq!(counts.mismatch, 0);
+    assert!(
+        counts.exact > 10_000,
+        "the suite must exercise hits: {counts:?}"
+    );
+}
+
+#[test]
+fn default_conforms() {
+    check(GridParams::default());
+}
+
+#[test]
+fn coarse_conforms() {
+    check(GridParams::coarse());
+}
+
+#[test]
+fn fine_conforms() {
+    check(GridParams::fine());
+}
+
+#[test]
+fn extreme_knobs_conform() {
+    // One cell for everything; a very dense grid capped at 8 cells per axis; a single cell
+    // per axis by cap.
+    check(GridParams::with_density(1e-6));
+    check(GridParams {
+        max_resolution: 8,
+        ..GridParams::with_density(64.0)
+    });
+    check(GridParams {
+        max_resolution: 1,
+        ..GridParams::default()
+    });
+    check(GridParams::with_density(200.0));
+}
+
+#[test]
+fn default_conforms_on_the_shared_scenes() {
+    let checked =
+        raybench_testkit::conformance_on_shared_scenes::<Grid>(&GridParams::default(), &|g, m| {
+            g.validate(m)
+        });
+    eprintln!("real scenes checked: {checked}");
+}
+
+#[test]
+fn too_large_is_an_error_not_an_abort() {
+    let mesh = raybench_scenes::generate("soup:triangles=2000", 1)
+        .unwrap()
+        .mesh;
+    let params = GridParams {
+        memory_limit_bytes: 64 * 1024,
+        ..GridParams::default()
+    };
+    match Grid::build(mesh.clone(), &params) {
+        Err(BuildError::TooLarge {
+            needed_bytes,
+            limit_bytes,
+        }) => assert!(needed_bytes > limit_bytes),
+        other => panic!("expected TooLarge, got {other:?}"),
+    }
+    // References alone over the limit (the offsets and copies fit).
+    let params = GridParams {
+        memory_limit_bytes: 2000 * 48 + 4 * 4100 + 12 * 1000,
+        ..GridParams::with_density(2.0)
+    };
+    assert!(matches!(
+        Grid::build(mesh, &params),
+        Err(BuildError::TooLarge { .. })
+    ));
+}
+
+/// A scene whose bounds are exactly [0, 4]³ and whose grid is 8³ cells of side 0.5 (dyadic
+/// planes), with triangles lying exactly on cell planes (G11), a random soup, and a big
+/// slanted triangle (hits beyond the current cell, B11).
+fn plane_scene() -> (Arc<TriangleMesh>, GridParams) {
+    let mut tris = vec![
+        // Pins for the bounds.
+        Triangle::new(
+            Vec3::ZERO,
+            Vec3::new(0.1, 0.0, 0.0),
+            Vec3::new(0.0, 0.1, 0.0),
+        ),
+        Triangle::new(
+            Vec3::splat(4.0),
+            Vec3::new(3.9, 4.0, 4.0),
+            Vec3::new(4.0, 3.9, 4.0),
+        ),
+        // On planes z = 2, x = 1.5 and y = 3 (cell planes), spanning several cells.
+        Triangle::new(
+            Vec3::new(0.5, 0.5, 2.0),
+            Vec3::new(3.5, 0.5, 2.0),
+            Vec3::new(0.5, 3.5, 2.0),
+        ),
+        Triangle::new(
+            Vec3::new(1.5, 0.5, 0.5),
+            Vec3::new(1.5, 3.0, 0.5),
+            Vec3::new(1.5, 0.5, 3.0),
+        ),
+        Triangle::new(
+            Vec3::new(2.5, 3.0, 0.5),
+            Vec3::new(3.5, 3.0, 0.5),
+            Vec3::new(2.5, 3.0, 3.5),
+        ),
+        // A big slanted triangle.
+        Triangle::new(
+            Vec3::new(0.2, 0.3, 3.9),
+            Vec3::new(3.9, 0.2, 0.1),
+            Vec3::new(2.0, 3.9, 2.0),
+        ),
+    ];
+    let mut rng = seeded_rng(0x5eed_6001);
+    let mut f = move || (rand_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
+    for _ in 0..400 {
+        let c = Vec3::new(f(), f(), f()) * 3.6 + 0.2;
+        let mut v = || c + (Vec3::new(f(), f(), f()) - 0.5) * 0.3;
+        tris.push(Triangle::new(v(), v(), v()));
+    }
+    let mesh = Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0);
+    // λN = 512 cells over a 4³ box: side 0.5, 8 per axis.
+    let params = GridParams::with_density(512.0 / mesh.len() as f64);
+    (mesh, params)
+}
+
+fn rand_u32(rng: &mut impl rand_core::Rng) -> u32 {
+    rng.next_u32()
+}
+
+/// Rays along cell planes, edges and through cell corners, axis-parallel with ±0 components,
+/// starting outside, inside, on planes and at grid vertices.
+fn plane_rays() -> Vec<Ray> {
+    let mut rays = Vec::new();
+    let lines: Vec<f32> = (0..=8).map(|k| k as f32 * 0.5).collect();
+    let signs = [(1.0f32, 0.0f32), (-1.0, -0.0)];
+    for &a in &lines {
+        for &b in &lines {
+            for (s, z) in signs {
+                // Along the z axis on the cell edge x = a, y = b: from outside and from inside.
+                rays.push(Ray::infinite(
+                    Vec3::new(a, b, 2.0 - 3.0 * s),
+                    Vec3::new(z, -z, s),
+                ));
+                rays.push(Ray::infinite(Vec3::new(a, b, 2.25), Vec3::new(z, z, s)));
+                // Along x on y = a, z = b, and along y on z = a, x = b.
+                rays.push(Ray::infinite(
+                    Vec3::new(2.0 - 3.0 * s, a, b),
+                    Vec3::new(s, z, z),
+                ));
+                rays.push(Ray::infinite(Vec3::new(b, 1.75, a), Vec3::new(-z, s, z)));
+            }
+            // In the plane x = a (d.x = ±0), oblique in y and z, through cell corners.
+            rays.push(Ray::infinite(
+                Vec3::new(a, -1.0, b - 1.0),
+                Vec3::new(0.0, 1.0, 1.0),
+            ));
+            rays.push(Ray::infinite(
+                Vec3::new(a, 5.0, b + 1.0),
+                Vec3::new(-0.0, -1.0, -1.0),
+            ));
+            // Diagonals through grid vertices, from inside with t_min > 0.
+            rays.push(Ray::new(
+                Vec3::new(a, b, 0.0),
+                Vec3::new(1.0, 1.0, 1.0),
+                0.25,
+                100.0,
+            ));
+            rays.push(Ray::new(
+                Vec3::new(a, b, 4.0),
+                Vec3::new(-1.0, 1.0, -1.0),
+                0.0,
+                3.0,
+            ));
+        }
+    }
+    // From every grid vertex (origin exactly on three planes) in seeded directions.
+    let mut rng = seeded_rng(0x5eed_6002);
+    for &x in lines.iter().step_by(2) {
+        for &y in lines.iter().step_by(2) {
+            for &z in lines.iter().step_by(2) {
+                let d = Vec3::new(
+                    rand_u32(&mut rng) as f32,
+                    rand_u32(&mut rng) as f32,
+                    rand_u32(&mut rng) as f32,
+                ) / u32::MAX as f32
+                    - 0.5;
+                rays.push(Ray::infinite(Vec3::new(x, y, z), d));
+                rays.push(Ray::infinite(Vec3::new(x, y, z), -d));
+            }
+        }
+    }
+    rays
+}
+
+#[test]
+fn rays_along_cell_planes_edges_and_corners() {
+    let (mesh, params) = plane_scene();
+    let grid = Grid::build(mesh.clone(), &params).unwrap();
+    assert_eq!(
+        grid.resolution(),
+        [8, 8, 8],
+        "the scene must give 0.5-wide cells"
+    );
+    let case = Case {
+        name: "cell-planes".into(),
+        seed: 0x5eed_6002,
+        mesh,
+        rays: plane_rays(),
+    };
+    let counts =
+        check_case::<Grid>(&case, &params, &|g, m| g.validate(m)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(counts.mismatch, 0);
+    assert!(counts.exact > 300, "{counts:?}");
+}
+
+#[test]
+fn walks_are_bounded_and_counted() {
+    let (mesh, params) = plane_scene();
+    let grid = Grid::build(mesh, &params).unwrap();
+    // A ray missing everything along a cell edge walks at most one row of cells.
+    let r = Ray::infinite(Vec3::new(0.5, 0.5, -1.0), Vec3::new(0.0, 0.0, 1.0));
+    let mut c = raybench_accel::Counters::default();
+    grid.intersect_counted(&r, &mut c);
+    assert!(c.cells >= 1 && c.cells <= 8, "{c:?}");
+    // The mailbox skips a triangle met again: the big slanted one spans many cells.
+    let mut total = raybench_accel::Counters::default();
+    for r in plane_rays() {
+        grid.intersect_counted(&r, &mut total);
+    }
+    assert!(total.mailbox_skips > 0, "{total:?}");
+    // Invalid rays (NaN, zero direction) miss in bounded time.
+    for r in [
+        Ray::infinite(Vec3::new(f32::NAN, 1.0, 1.0), Vec3::X),
+        Ray::infinite(Vec3::splat(1.0), Vec3::new(f32::NAN, 1.0, 0.0)),
+        Ray::infinite(Vec3::splat(1.0), Vec3::ZERO),
+        Ray::new(Vec3::splat(1.0), Vec3::X, f32::NAN, f32::NAN),
+    ] {
+        let mut c = raybench_accel::Counters::default();
+        let _ = grid.intersect_counted(&r, &mut c);
+        assert!(c.cells <= 24, "{r:?}: {c:?}");
+    }
+}

@@ -1,0 +1,279 @@
+//! k-d tree construction, shared by both builders: the depth-first output (nodes written in
+//! place, one reference array), the depth limit, the reference budget, the statistics and the
+//! final reordering of triangles into leaf order.
+//!
+//! * [`sah`]: Wald and Havran's O(N log N) SAH builder with perfect splits.
+//! * [`median`]: spatial median, round-robin axes.
+//!
+//! Both recurse on a node's cell and the triangles' bounds clipped to it, and split with the
+//! one rule of [`crate::clip::side`]. Termination and degenerate input are handled the same
+//! way in both: a split plane always lies strictly inside its cell (so no child is ever flat
+//! on the split axis, and a flat root cell is never split on its flat axis), the depth is
+//! capped ([`KdParams::max_depth`], at most [`MAX_DEPTH`]), and a build-wide reference budget
+//! ([`KdParams::max_refs_per_triangle`]) turns the remaining nodes into leaves once it is
+//! spent, so neither recursion nor memory can grow without bound, whatever the input (huge
+//! triangles spanning the scene, thousands of triangles in one plane or at one point).
+//!
+//! Triangles whose precomputed normal is exactly zero in f32 can never be hit (Möller–Trumbore
+//! rejects `den == 0`), so they are left out of the tree and counted in the statistics
+//! (`excluded_degenerate`).
+
+pub mod median;
+pub mod sah;
+
+use crate::node::{MAX_DEPTH, MAX_PACKED, Node};
+use crate::{Builder, KdParams};
+use raybench_accel::{BuildError, BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
+use raybench_geom::{Aabb, MollerTriangle, Triangle, TriangleMesh, Vec3};
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicI64, Ordering};
+
+/// Havran's default depth limit, `round(8 + 1.3 log2 N)` (Havran 2000, §4.5), within
+/// [`MAX_DEPTH`].
+pub fn default_max_depth(n: usize) -> u32 {
+    let d = 8.0 + 1.3 * (n.max(1) as f64).log2();
+    (d.round() as u32).min(MAX_DEPTH as u32)
+}
+
+/// What every node of a build needs to know.
+pub(crate) struct Ctx<'a> {
+    pub tris: &'a [Triangle],
+    pub params: &'a KdParams,
+    pub max_depth: u32,
+    pub root_area: f64,
+    /// References still allowed beyond one per triangle (see [`Ctx::take_budget`]).
+    budget: AtomicI64,
+    /// Nodes above this depth may build their subtrees on two rayon tasks.
+    pub fork_depth: u32,
+}
+
+impl Ctx<'_> {
+    /// Reserves `extra` more references for a split; false (and nothing reserved) when the
+    /// budget cannot cover them. Relaxed atomics: when the budget runs out during a parallel
+    /// build, which nodes got the last of it depends on scheduling; until then the tree is
+    /// deterministic.
+    pub fn take_budget(&self, extra: usize) -> bool {
+        let extra = extra as i64;
+        if self.budget.load(Ordering::Relaxed) < extra {
+            return false;
+        }
+        self.budget.fetch_sub(extra, Ordering::Relaxed) >= extra
+    }
+
+    pub fn fork(&self, n: usize, depth: u32) -> bool {
+        depth < self.fork_depth && n > self.params.parallel_threshold as usize
+    }
+}
+
+/// Shape facts gathered while nodes are written.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Shape {
+    interior: u64,
+    leaves: u64,
+    empty_leaves: u64,
+    refs: u64,
+    max_depth: u32,
+    leaf_depth_sum: u64,
+    max_leaf_size: u32,
+    /// Σ area(cell)/area(root) × cost, see [`Out::leaf`] and [`Out::interior`].
+    sah: f64,
+}
+
+impl Shape {
+    fn add(&mut self, o: &Shape) {
+        self.interior += o.interior;
+        self.leaves += o.leaves;
+        self.empty_leaves += o.empty_leaves;
+        self.refs += o.refs;
+        self.max_depth = self.max_depth.max(o.max_depth);
+        self.leaf_depth_sum += o.leaf_depth_sum;
+        self.max_leaf_size = self.max_leaf_size.max(o.max_leaf_size);
+        self.sah += o.sah;
+    }
+}
+
+/// A depth-first subtree being written: an interior node is followed by its subtree below the
+/// plane, then the one above; leaves point into `refs` (mesh triangle ids until
+/// [`finish`] renumbers them).
+#[derive(Debug, Default)]
+pub(crate) struct Out {
+    pub nodes: Vec<Node>,
+    pub refs: Vec<u32>,
+    pub shape: Shape,
+}
+
+impl Out {
+    /// Writes a leaf holding `ids` (sorted, so leaves are deterministic whatever order the
+    /// builder collected them in).
+    pub fn leaf(&mut self, ctx: &Ctx, cell: &Aabb, depth: u32, mut ids: Vec<u32>) {
+        ids.sort_unstable();
+        let count = ids.len() as u32;
+        self.nodes
+            .push(Node::leaf(self.refs.len() as u32, count.min(MAX_PACKED)));
+        self.refs.extend_from_slice(&ids);
+        let s = &mut self.shape;
+        s.leaves += 1;
+        s.empty_leaves += (count == 0) as u64;
+        s.refs += count as u64;
+        s.max_depth = s.max_depth.max(depth);
+        s.leaf_depth_sum += depth as u64;
+        s.max_leaf_size = s.max_leaf_size.max(count);
+        if ctx.root_area > 0.0 {
+            s.sah += cell.surface_area() / ctx.root_area * count as f64 * SAH_INTERSECTION_COST;
+        }
+    }
+
+    /// Reserves the slot of an interior node; its subtree below the plane follows it. The node
+    /// is written by [`Out::close_interior`] once the subtree above has begun.
+    pub fn open_interior(&mut self, ctx: &Ctx, cell: &Aabb) -> usize {
+        let at = self.nodes.len();
+        self.nodes.push(Node::default());
+        self.shape.interior += 1;
+        if ctx.root_area > 0.0 {
+            self.shape.sah += cell.surface_area() / ctx.root_area * SAH_TRAVERSAL_COST;
+        }
+        at
+    }
+
+    pub fn close_interior(&mut self, at: usize, axis: usize, split: f32, above_at: usize) {
+        self.nodes[at] = Node::interior(axis, split, (above_at as u32).min(MAX_PACKED));
+    }
+
+    /// Appends a subtree written on its own, shifting its node and reference indices.
+    pub fn append(&mut self, sub: Out) {
+        let (node_base, ref_base) = (self.nodes.len() as u32, self.refs.len() as u32);
+        self.nodes.extend(sub.nodes.into_iter().map(|n| {
+            if n.is_leaf() {
+                Node::leaf(n.first() + ref_base, n.count())
+            } else {
+                Node::interior(n.axis(), n.split(), (n.above() + node_base).min(MAX_PACKED))
+            }
+        }));
+        self.refs.extend_from_slice(&sub.refs);
+        self.shape.add(&sub.shape);
+    }
+}
+
+/// A built, flattened tree.
+pub(crate) struct Flat {
+    pub nodes: Vec<Node>,
+    pub refs: Vec<u32>,
+    pub triangles: Vec<MollerTriangle>,
+    pub prim_ids: Vec<u32>,
+    pub bounds: Aabb,
+    pub depth_limit: u32,
+    pub stats: BuildStats,
+}
+
+/// Largest number of triangles a build accepts: the SAH builder packs a triangle id into 30
+/// bits of an event.
+pub const MAX_TRIANGLES: usize = 1 << 30;
+
+pub(crate) fn build(mesh: &TriangleMesh, params: &KdParams) -> Result<Flat, BuildError> {
+    let tris: Vec<Triangle> = mesh.triangles().collect();
+    let ids: Vec<u32> = (0..tris.len() as u32)
+        .filter(|&i| MollerTriangle::new(&tris[i as usize]).ng != Vec3::ZERO)
+        .collect();
+    if ids.len() >= MAX_TRIANGLES {
+        return Err(BuildError::Unsupported(format!(
+            "{} triangles; the k-d tree builds at most {MAX_TRIANGLES}",
+            ids.len()
+        )));
+    }
+    let excluded = tris.len() - ids.len();
+    let bounds = ids
+        .iter()
+        .fold(Aabb::EMPTY, |b, &i| b.union(&tris[i as usize].bounds()));
+    let n = ids.len();
+    let depth_limit = params
+        .max_depth
+        .unwrap_or_else(|| default_max_depth(n))
+        .min(MAX_DEPTH as u32);
+    let max_refs = (n as f64 * params.max_refs_per_triangle as f64).min(u32::MAX as f64 / 2.0);
+    let threads = rayon::current_num_threads();
+    let ctx = Ctx {
+        tris: &tris,
+        params,
+        max_depth: depth_limit,
+        root_area: bounds.surface_area(),
+        budget: AtomicI64::new(max_refs as i64 - n as i64),
+        // A few tasks per worker (2^fork_depth ≥ 4 × threads), none with one thread.
+        fork_depth: if threads > 1 {
+            (usize::BITS - (threads - 1).leading_zeros()) + 2
+        } else {
+            0
+        },
+    };
+    let mut out = Out::default();
+    if n > 0 {
+        match params.builder {
+            Builder::Sah => sah::build(&ctx, &ids, &bounds, &mut out),
+            Builder::Median => median::build(&ctx, &ids, &bounds, &mut out),
+        }
+    }
+    if out.nodes.len() > MAX_PACKED as usize || out.shape.max_leaf_size >= MAX_PACKED {
+        return Err(BuildError::TooLarge {
+            needed_bytes: (out.nodes.len() * 8 + out.refs.len() * 4) as u64,
+            limit_bytes: (MAX_PACKED as u64) * 8,
+        });
+    }
+    // Triangles in the order leaves first reference them: a leaf's triangles sit together in
+    // memory, and neighbouring leaves mostly share theirs.
+    let mut new_id = vec![u32::MAX; tris.len()];
+    let mut prim_ids = Vec::with_capacity(n);
+    for r in out.refs.iter_mut() {
+        let slot = &mut new_id[*r as usize];
+        if *slot == u32::MAX {
+            *slot = prim_ids.len() as u32;
+            prim_ids.push(*r);
+        }
+        *r = *slot;
+    }
+    let triangles = prim_ids
+        .iter()
+        .map(|&i| MollerTriangle::new(&tris[i as usize]))
+        .collect();
+    let stats = stats(&out.shape, n, excluded, depth_limit, bounds.surface_area());
+    Ok(Flat {
+        nodes: out.nodes,
+        refs: out.refs,
+        triangles,
+        prim_ids,
+        bounds,
+        depth_limit,
+        stats,
+    })
+}
+
+/// The statistics of a finished tree.
+///
+/// `sah_cost` is the cost model of a space-partitioning tree with the shared constants, the
+/// way the BVH crate computes it for its tree: Σ over interior nodes of
+/// `area(cell)/area(root) × C_trav` plus Σ over leaves of `area(cell)/area(root) × refs ×
+/// C_isect`, where a cell is the node's region of space (not a tight box, which a k-d tree
+/// does not store). Duplicated references are counted in every leaf that holds them. `None`
+/// when the root cell has no area.
+fn stats(s: &Shape, n: usize, excluded: usize, depth_limit: u32, root_area: f64) -> BuildStats {
+    let mut extra = BTreeMap::new();
+    let leaves = s.leaves.max(1) as f64;
+    let full = (s.leaves - s.empty_leaves).max(1) as f64;
+    extra.insert("empty_leaves".into(), s.empty_leaves as f64);
+    extra.insert(
+        "refs_per_triangle".into(),
+        if n > 0 { s.refs as f64 / n as f64 } else { 0.0 },
+    );
+    extra.insert("mean_leaf_depth".into(), s.leaf_depth_sum as f64 / leaves);
+    extra.insert("mean_full_leaf_size".into(), s.refs as f64 / full);
+    extra.insert("max_leaf_size".into(), s.max_leaf_size as f64);
+    extra.insert("depth_limit".into(), depth_limit as f64);
+    extra.insert("excluded_degenerate".into(), excluded as f64);
+    BuildStats {
+        // Interior nodes plus leaves, as every structure counts them.
+        nodes: s.interior + s.leaves,
+        leaves: s.leaves,
+        max_depth: s.max_depth,
+        refs: s.refs,
+        sah_cost: (root_area > 0.0 && n > 0).then_some(s.sah),
+        extra,
+    }
+}

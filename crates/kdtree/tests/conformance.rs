@@ -1,0 +1,70 @@
+//! The shared conformance suite for both k-d tree variants and for extreme knobs, with
+//! `validate()` after every build; the real scenes of ../shared/scenes for kd-sah.
+
+use raybench_kdtree::{KdParams, KdTree};
+use raybench_testkit::conformance;
+
+fn check(params: KdParams) {
+    let counts = conformance::<KdTree>(&params, &|kd, mesh| kd.validate(mesh));
+    assert_eq!(counts.mismatch, 0);
+    assert!(
+        counts.exact > 10_000,
+        "the suite must exercise hits: {counts:?}"
+    );
+}
+
+#[test]
+fn sah_conforms() {
+    check(KdParams::sah());
+}
+
+#[test]
+fn median_conforms() {
+    check(KdParams::median());
+}
+
+#[test]
+fn without_mailbox_conforms() {
+    check(KdParams {
+        mailbox: false,
+        ..KdParams::sah()
+    });
+}
+
+#[test]
+fn extreme_knobs_conform() {
+    // A single leaf holding everything (depth 0).
+    check(KdParams {
+        max_depth: Some(0),
+        ..KdParams::sah()
+    });
+    // Splitting always pays (free traversal, no empty bonus): deep trees, tiny leaves, many
+    // duplicated references, up to the reference budget.
+    check(KdParams {
+        traversal_cost: 0.0,
+        empty_bonus: 1.0,
+        max_refs_per_triangle: 4.0,
+        ..KdParams::sah()
+    });
+    // Aggressive empty-space cutting and a tight reference budget on the median tree, with
+    // leaves of one triangle and a deep limit.
+    check(KdParams {
+        empty_bonus: 0.1,
+        ..KdParams::sah()
+    });
+    check(KdParams {
+        leaf_size: 1,
+        max_depth: Some(40),
+        max_refs_per_triangle: 1.5,
+        ..KdParams::median()
+    });
+}
+
+#[test]
+fn sah_conforms_on_the_shared_scenes() {
+    let checked =
+        raybench_testkit::conformance_on_shared_scenes::<KdTree>(&KdParams::sah(), &|kd, m| {
+            kd.validate(m)
+        });
+    eprintln!("real scenes checked: {checked}");
+}

@@ -1,0 +1,230 @@
+//! k-d tree specific cases on top of the shared suite: rays lying exactly in split planes,
+//! triangles lying in split planes, a huge triangle spanning the scene, parallel builds, and
+//! what the counters must show (early exit, mailbox skips).
+
+use raybench_accel::{Accel, BruteForce, Counters};
+use raybench_geom::{Aabb, Ray, Triangle, TriangleMesh, Vec3};
+use raybench_kdtree::{KdParams, KdTree};
+use raybench_testkit::{Case, check_case, random_rays_in, seeded_rng};
+use std::sync::Arc;
+
+const SEED: u64 = 0x5eed_0d05;
+
+fn both_variants() -> [KdParams; 2] {
+    [KdParams::sah(), KdParams::median()]
+}
+
+fn check(case: &Case) {
+    for p in both_variants() {
+        let counts = check_case::<KdTree>(case, &p, &|kd, m| kd.validate(m))
+            .unwrap_or_else(|e| panic!("{}: {e}", p.name()));
+        assert_eq!(counts.mismatch, 0);
+    }
+}
+
+/// Axis-parallel rays (±0 components) whose origin lies exactly in a split plane of the tree:
+/// `t_split = 0 × inf = NaN`, so both children must be walked over the whole interval.
+fn rays_in_split_planes(kd: &KdTree, n: usize, seed: u64) -> Vec<Ray> {
+    let b = kd.bounds().enlarged(0.05);
+    let mut rng = seeded_rng(seed);
+    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
+    let splits: Vec<(usize, f32)> = kd
+        .nodes()
+        .iter()
+        .filter(|n| !n.is_leaf())
+        .map(|n| (n.axis(), n.split()))
+        .collect();
+    let mut rays = Vec::new();
+    for i in 0..n {
+        let (axis, p) = splits[i % splits.len()];
+        let mut o = b.min + Vec3::new(f(), f(), f()) * b.extent();
+        o[axis] = p;
+        // Travel along one of the two other axes, the split axis's component ±0.
+        let along = (axis + 1 + (i % 2)) % 3;
+        let mut d = Vec3::splat(if i % 4 < 2 { 0.0 } else { -0.0 });
+        d[along] = if i % 3 == 0 { -1.0 } else { 1.0 };
+        // Half of them start outside the box on that axis.
+        if i % 5 == 0 {
+            o[along] = if d[along] > 0.0 {
+                b.min[along]
+            } else {
+                b.max[along]
+            };
+        }
+        rays.push(Ray::infinite(o, d));
+    }
+    rays
+}
+
+#[test]
+fn triangles_and_rays_in_split_planes() {
+    for spec in [
+        "coplanar:triangles=3000",
+        "city:triangles=3000",
+        "plane:quads=16,tilt_deg=0",
+    ] {
+        let mesh = raybench_scenes::generate(spec, SEED).unwrap().mesh;
+        for p in both_variants() {
+            let kd = KdTree::build(mesh.clone(), &p).unwrap();
+            let mut rays = rays_in_split_planes(&kd, 3000, SEED);
+            rays.extend(random_rays_in(&mesh.bounds().enlarged(0.1), 1000, SEED));
+            let case = Case {
+                name: format!("{spec} ({})", p.name()),
+                seed: SEED,
+                mesh: mesh.clone(),
+                rays,
+            };
+            let counts = check_case::<KdTree>(&case, &p, &|kd, m| kd.validate(m))
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(counts.mismatch, 0);
+            assert!(counts.exact > 100, "{spec}: {counts:?}");
+        }
+    }
+}
+
+#[test]
+fn a_huge_triangle_over_small_ones_stays_bounded() {
+    let mut rng = seeded_rng(SEED);
+    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
+    let mut tris: Vec<Triangle> = (0..2000)
+        .map(|_| {
+            let c = Vec3::new(f(), f(), f());
+            let mut v = || c + (Vec3::new(f(), f(), f()) - 0.5) * 0.05;
+            Triangle::new(v(), v(), v())
+        })
+        .collect();
+    // Two huge triangles crossing the whole scene diagonally.
+    tris.push(Triangle::new(
+        Vec3::new(-10.0, -10.0, 0.5),
+        Vec3::new(10.0, -10.0, 0.3),
+        Vec3::new(0.0, 10.0, 0.6),
+    ));
+    tris.push(Triangle::new(
+        Vec3::new(0.5, -10.0, -10.0),
+        Vec3::new(0.4, 10.0, -10.0),
+        Vec3::new(0.6, 0.0, 10.0),
+    ));
+    let mesh = Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0);
+    for p in both_variants() {
+        let kd = KdTree::build(mesh.clone(), &p).unwrap();
+        let s = kd.build_stats();
+        let dup = s.extra["refs_per_triangle"];
+        assert!(dup <= p.max_refs_per_triangle as f64, "{}: {dup}", p.name());
+        assert!(s.max_depth <= s.extra["depth_limit"] as u32);
+    }
+    let rays = random_rays_in(&mesh.bounds().enlarged(0.1), 3000, SEED);
+    check(&Case {
+        name: "huge-triangles".into(),
+        seed: SEED,
+        mesh,
+        rays,
+    });
+}
+
+#[test]
+fn the_reference_budget_caps_duplication() {
+    // 300 long thin triangles crossing each other: every split duplicates many of them.
+    let mesh = raybench_scenes::generate("hair:triangles=300,length=1", SEED)
+        .unwrap()
+        .mesh;
+    let p = KdParams {
+        traversal_cost: 0.0,
+        empty_bonus: 1.0,
+        max_refs_per_triangle: 2.0,
+        ..KdParams::sah()
+    };
+    let kd = KdTree::build(mesh.clone(), &p).unwrap();
+    assert_eq!(kd.validate(&mesh), Ok(()));
+    // The budget is checked before each split: at most one split's worth over it.
+    assert!(kd.build_stats().extra["refs_per_triangle"] <= 2.0 + 1.0);
+}
+
+#[test]
+fn parallel_and_sequential_builds_make_the_same_tree() {
+    let mesh = raybench_scenes::generate("sphere:triangles=40000", SEED)
+        .unwrap()
+        .mesh;
+    for p in both_variants() {
+        let p = KdParams {
+            parallel_threshold: 256,
+            ..p
+        };
+        let build = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| KdTree::build(mesh.clone(), &p).unwrap())
+        };
+        let (one, four) = (build(1), build(4));
+        assert_eq!(four.validate(&mesh), Ok(()));
+        assert_eq!(one.nodes(), four.nodes(), "{}", p.name());
+        assert_eq!(one.refs(), four.refs());
+        assert_eq!(one.prim_ids(), four.prim_ids());
+    }
+}
+
+#[test]
+fn counters_show_early_exit_and_mailbox_skips() {
+    let mesh = raybench_scenes::generate("sphere:triangles=20000", SEED)
+        .unwrap()
+        .mesh;
+    let kd = KdTree::build(mesh.clone(), &KdParams::sah()).unwrap();
+    let no_mb = KdTree::build(
+        mesh.clone(),
+        &KdParams {
+            mailbox: false,
+            ..KdParams::sah()
+        },
+    )
+    .unwrap();
+    let bf = BruteForce::build(mesh.clone(), &Default::default()).unwrap();
+    // Rays through the centre from outside: the first leaf hit ends the walk, far before the
+    // back of the sphere.
+    let rays: Vec<Ray> =
+        random_rays_in(&Aabb::new(Vec3::splat(-0.2), Vec3::splat(0.2)), 2000, SEED)
+            .into_iter()
+            .map(|r| Ray::infinite(r.origin() - r.dir() * 3.0, r.dir()))
+            .collect();
+    let (mut c, mut c_no) = (Counters::default(), Counters::default());
+    for r in &rays {
+        let h = kd.intersect_counted(r, &mut c);
+        assert_eq!(h.map(|h| h.prim), bf.intersect(r).map(|h| h.prim));
+        no_mb.intersect_counted(r, &mut c_no);
+    }
+    let n = rays.len() as u64;
+    let leaves_total = kd.build_stats().leaves;
+    assert!(c.leaves < 30 * n, "early exit: {c:?}");
+    assert!(
+        c.leaves * 100 < leaves_total * n,
+        "a ray visits a tiny part: {c:?}"
+    );
+    assert_eq!(c_no.mailbox_skips, 0);
+    assert_eq!(
+        c.prim_tests + c.mailbox_skips,
+        c_no.prim_tests,
+        "a skip replaces a test"
+    );
+    let mut any = Counters::default();
+    for r in &rays {
+        assert!(kd.occluded_counted(r, &mut any));
+    }
+    assert!(
+        any.prim_tests <= c.prim_tests,
+        "any hit stops at the first hit"
+    );
+}
+
+#[test]
+fn mailbox_skips_happen_on_duplicated_references() {
+    // Long needles crossing many cells: the same triangle is met again in later leaves.
+    let mesh = raybench_scenes::generate("hair:triangles=2000", SEED)
+        .unwrap()
+        .mesh;
+    let kd = KdTree::build(mesh.clone(), &KdParams::sah()).unwrap();
+    let mut c = Counters::default();
+    for r in random_rays_in(&mesh.bounds(), 2000, SEED) {
+        kd.intersect_counted(&r, &mut c);
+    }
+    assert!(c.mailbox_skips > 0, "{c:?}");
+}

@@ -1,0 +1,251 @@
+//! The shared conformance suite for the octree, `validate()` after every build, plus rays
+//! aimed at the octree's own geometry: axis-parallel, starting inside, exactly along split
+//! planes, octant edges and corners.
+
+use raybench_accel::{Accel, BuildError, Counters};
+use raybench_geom::{Ray, Triangle, TriangleMesh, Vec3};
+use raybench_octree::{Octree, OctreeParams};
+use raybench_testkit::{Case, check_case, conformance, seeded_rng};
+use std::sync::Arc;
+
+fn check(params: OctreeParams) {
+    let counts = conformance::<Octree>(&params, &|t, mesh| t.validate(mesh));
+    assert_eq!(counts.mismatch, 0);
+    assert!(
+        counts.exact > 10_000,
+        "the suite must exercise hits: {counts:?}"
+    );
+}
+
+#[test]
+fn default_conforms() {
+    check(OctreeParams::default());
+}
+
+#[test]
+fn extreme_knobs_conform() {
+    // One triangle per leaf as deep as allowed; a single leaf; shallow with big leaves; and
+    // the serial build path.
+    check(OctreeParams {
+        max_obj: 1,
+        max_depth: raybench_octree::MAX_DEPTH_LIMIT,
+        ..OctreeParams::default()
+    });
+    check(OctreeParams {
+        max_depth: 0,
+        ..OctreeParams::default()
+    });
+    check(OctreeParams {
+        max_obj: 64,
+        max_depth: 3,
+        parallel_threshold: u32::MAX,
+        ..OctreeParams::default()
+    });
+}
+
+#[test]
+fn default_conforms_on_the_shared_scenes() {
+    let checked = raybench_testkit::conformance_on_shared_scenes::<Octree>(
+        &OctreeParams::default(),
+        &|t, m| t.validate(m),
+    );
+    eprintln!("real scenes checked: {checked}");
+}
+
+#[test]
+fn too_large_is_an_error_not_an_abort() {
+    let mesh = raybench_scenes::generate("soup:triangles=2000", 1)
+        .unwrap()
+        .mesh;
+    for limit in [1024, 2000 * 72 + 4096] {
+        let params = OctreeParams {
+            memory_limit_bytes: limit,
+            max_obj: 1,
+            ..OctreeParams::default()
+        };
+        match Octree::build(mesh.clone(), &params) {
+            Err(BuildError::TooLarge {
+                needed_bytes,
+                limit_bytes,
+            }) => assert!(needed_bytes > limit_bytes),
+            other => panic!("limit {limit}: expected TooLarge, got {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn degenerate_inputs_stop_early() {
+    // 1000 identical triangles, a single point, triangles with one centroid: one leaf. A fan
+    // of needles from one vertex legitimately goes deep (each needle crosses many cells), but
+    // stays bounded.
+    for (spec, max_refs_per_tri) in [
+        ("identical:triangles=1000", 1.0),
+        ("identical:triangles=1000,size=0", 1.0),
+        ("one-centroid:triangles=1000", 1.0),
+        ("fan:triangles=5000", 1000.0),
+    ] {
+        let mesh = raybench_scenes::generate(spec, 1).unwrap().mesh;
+        let tree = Octree::build(mesh.clone(), &OctreeParams::default()).unwrap();
+        tree.validate(&mesh).unwrap();
+        let s = tree.build_stats();
+        assert!(
+            (s.refs as f64) <= max_refs_per_tri * mesh.len() as f64,
+            "{spec}: {s:?}"
+        );
+    }
+}
+
+/// A scene whose bounds are exactly [0, 4]³, so the root is that cube and every split plane is
+/// a multiple of a power of two: triangles lie exactly on split planes (G11), plus a random
+/// soup and a big slanted triangle (hits beyond the current leaf, B11).
+fn plane_scene() -> Arc<TriangleMesh> {
+    let mut tris = vec![
+        Triangle::new(
+            Vec3::ZERO,
+            Vec3::new(0.1, 0.0, 0.0),
+            Vec3::new(0.0, 0.1, 0.0),
+        ),
+        Triangle::new(
+            Vec3::splat(4.0),
+            Vec3::new(3.9, 4.0, 4.0),
+            Vec3::new(4.0, 3.9, 4.0),
+        ),
+        Triangle::new(
+            Vec3::new(0.5, 0.5, 2.0),
+            Vec3::new(3.5, 0.5, 2.0),
+            Vec3::new(0.5, 3.5, 2.0),
+        ),
+        Triangle::new(
+            Vec3::new(1.0, 0.5, 0.5),
+            Vec3::new(1.0, 3.0, 0.5),
+            Vec3::new(1.0, 0.5, 3.0),
+        ),
+        Triangle::new(
+            Vec3::new(2.5, 3.0, 0.5),
+            Vec3::new(3.5, 3.0, 0.5),
+            Vec3::new(2.5, 3.0, 3.5),
+        ),
+        Triangle::new(
+            Vec3::new(0.2, 0.3, 3.9),
+            Vec3::new(3.9, 0.2, 0.1),
+            Vec3::new(2.0, 3.9, 2.0),
+        ),
+    ];
+    let mut rng = seeded_rng(0x5eed_6001);
+    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
+    for _ in 0..400 {
+        let c = Vec3::new(f(), f(), f()) * 3.6 + 0.2;
+        let mut v = || c + (Vec3::new(f(), f(), f()) - 0.5) * 0.3;
+        tris.push(Triangle::new(v(), v(), v()));
+    }
+    Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0)
+}
+
+/// Rays along split planes, octant edges and through octant corners (multiples of 0.5),
+/// axis-parallel with ±0 components, starting outside, inside, on planes and at corners.
+fn plane_rays() -> Vec<Ray> {
+    let mut rays = Vec::new();
+    let lines: Vec<f32> = (0..=8).map(|k| k as f32 * 0.5).collect();
+    let signs = [(1.0f32, 0.0f32), (-1.0, -0.0)];
+    for &a in &lines {
+        for &b in &lines {
+            for (s, z) in signs {
+                rays.push(Ray::infinite(
+                    Vec3::new(a, b, 2.0 - 3.0 * s),
+                    Vec3::new(z, -z, s),
+                ));
+                rays.push(Ray::infinite(Vec3::new(a, b, 2.25), Vec3::new(z, z, s)));
+                rays.push(Ray::infinite(
+                    Vec3::new(2.0 - 3.0 * s, a, b),
+                    Vec3::new(s, z, z),
+                ));
+                rays.push(Ray::infinite(Vec3::new(b, 1.75, a), Vec3::new(-z, s, z)));
+            }
+            rays.push(Ray::infinite(
+                Vec3::new(a, -1.0, b - 1.0),
+                Vec3::new(0.0, 1.0, 1.0),
+            ));
+            rays.push(Ray::infinite(
+                Vec3::new(a, 5.0, b + 1.0),
+                Vec3::new(-0.0, -1.0, -1.0),
+            ));
+            rays.push(Ray::new(
+                Vec3::new(a, b, 0.0),
+                Vec3::new(1.0, 1.0, 1.0),
+                0.25,
+                100.0,
+            ));
+            rays.push(Ray::new(
+                Vec3::new(a, b, 4.0),
+                Vec3::new(-1.0, 1.0, -1.0),
+                0.0,
+                3.0,
+            ));
+        }
+    }
+    let mut rng = seeded_rng(0x5eed_6002);
+    let mut u = move || rand_core::Rng::next_u32(&mut rng) as f32 / u32::MAX as f32 - 0.5;
+    for &x in lines.iter().step_by(2) {
+        for &y in lines.iter().step_by(2) {
+            for &z in lines.iter().step_by(2) {
+                let d = Vec3::new(u(), u(), u());
+                rays.push(Ray::infinite(Vec3::new(x, y, z), d));
+                rays.push(Ray::infinite(Vec3::new(x, y, z), -d));
+            }
+        }
+    }
+    rays
+}
+
+#[test]
+fn rays_along_split_planes_edges_and_corners() {
+    let mesh = plane_scene();
+    for params in [
+        OctreeParams::default(),
+        OctreeParams {
+            max_obj: 1,
+            ..OctreeParams::default()
+        },
+    ] {
+        let tree = Octree::build(mesh.clone(), &params).unwrap();
+        assert_eq!(tree.root_box().min, Vec3::ZERO);
+        assert_eq!(tree.root_box().max, Vec3::splat(4.0));
+        assert!(
+            tree.build_stats().max_depth >= 3,
+            "{:?}",
+            tree.build_stats()
+        );
+        let case = Case {
+            name: "split-planes".into(),
+            seed: 0x5eed_6002,
+            mesh: mesh.clone(),
+            rays: plane_rays(),
+        };
+        let counts = check_case::<Octree>(&case, &params, &|t, m| t.validate(m))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(counts.mismatch, 0);
+        assert!(counts.exact > 300, "{counts:?}");
+    }
+}
+
+#[test]
+fn walks_are_bounded_and_counted() {
+    let mesh = plane_scene();
+    let tree = Octree::build(mesh, &OctreeParams::default()).unwrap();
+    let mut total = Counters::default();
+    for r in plane_rays() {
+        tree.intersect_counted(&r, &mut total);
+    }
+    assert!(total.mailbox_skips > 0, "{total:?}");
+    assert!(total.leaves > 0 && total.nodes > 0, "{total:?}");
+    for r in [
+        Ray::infinite(Vec3::new(f32::NAN, 1.0, 1.0), Vec3::X),
+        Ray::infinite(Vec3::splat(1.0), Vec3::new(f32::NAN, 1.0, 0.0)),
+        Ray::infinite(Vec3::splat(1.0), Vec3::ZERO),
+        Ray::new(Vec3::splat(1.0), Vec3::X, f32::NAN, f32::NAN),
+    ] {
+        let mut c = Counters::default();
+        let _ = tree.intersect_counted(&r, &mut c);
+        assert!(c.nodes + c.leaves <= 64, "{r:?}: {c:?}");
+    }
+}
