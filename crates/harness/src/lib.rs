@@ -2,6 +2,7 @@
 //! validates every ray against a reference, and writes `report.json`.
 #![forbid(unsafe_code)]
 
+pub mod compare;
 pub mod env;
 pub mod measure;
 pub mod registry;

@@ -32,6 +32,23 @@ enum Command {
     /// Look at scenes: list generators and views, export as OBJ, render a preview PNG.
     #[command(subcommand)]
     Scene(SceneCommand),
+    /// Compare two reports: a Markdown table of changes; exit 2 on a regression (a mismatch
+    /// rose, a deterministic figure changed, a timing ratio worsened beyond --max-slowdown).
+    Compare(CompareArgs),
+}
+
+#[derive(Args, Debug)]
+struct CompareArgs {
+    /// The baseline report.json.
+    base: PathBuf,
+    /// The report.json to judge.
+    new: PathBuf,
+    /// A timing ratio to the reference worse by more than this percentage is a regression.
+    #[arg(long, default_value_t = 10.0)]
+    max_slowdown: f64,
+    /// Print timing slowdowns without failing on them (for CI on shared machines).
+    #[arg(long)]
+    timing_advisory: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -139,7 +156,32 @@ fn real_main() -> Result<ExitCode> {
         Command::List => list().map(|_| ExitCode::SUCCESS),
         Command::Run(args) => run_command(args),
         Command::Scene(cmd) => scene_command(cmd).map(|_| ExitCode::SUCCESS),
+        Command::Compare(args) => compare_command(args),
     }
+}
+
+fn compare_command(args: CompareArgs) -> Result<ExitCode> {
+    use raybench_harness::compare::{CompareOptions, compare};
+    use raybench_harness::report::Report;
+    anyhow::ensure!(
+        args.max_slowdown.is_finite() && args.max_slowdown >= 0.0,
+        "--max-slowdown must be a percentage >= 0 (got {})",
+        args.max_slowdown
+    );
+    let base = Report::read(&args.base)?;
+    let new = Report::read(&args.new)?;
+    let opts = CompareOptions {
+        max_slowdown: args.max_slowdown / 100.0,
+        timing_advisory: args.timing_advisory,
+    };
+    let c = compare(&base, &new, &opts);
+    print!("{}", c.markdown);
+    Ok(if c.regressions() > 0 {
+        eprintln!("raybench compare: {} regression(s)", c.regressions());
+        ExitCode::from(2)
+    } else {
+        ExitCode::SUCCESS
+    })
 }
 
 fn scene_command(cmd: SceneCommand) -> Result<()> {
