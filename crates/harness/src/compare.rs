@@ -142,7 +142,7 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
             what: format!("{} / {}: new in this report (no baseline)", key.0, key.1),
         });
     }
-    findings.sort_by(|a, b| a.severity.cmp(&b.severity));
+    findings.sort_by_key(|f| f.severity);
     let markdown = markdown(base, new, &rows, &findings, opts);
     Comparison { markdown, findings }
 }

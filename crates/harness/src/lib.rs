@@ -4,8 +4,10 @@
 
 pub mod compare;
 pub mod env;
+pub mod images;
 pub mod measure;
 pub mod registry;
+pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene_cmd;
