@@ -2,7 +2,7 @@
 //! (see README, "Adding a structure").
 
 use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
-use raybench_bvh::{Bvh, BvhParams};
+use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
 use std::sync::Arc;
@@ -133,6 +133,12 @@ pub fn registry() -> Vec<StructureEntry> {
         // k-d trees (raybench-kdtree) go here.
         // Uniform grids (raybench-grid) go here.
         // Octrees (raybench-octree) go here.
+        register::<Bvh8>(
+            "bvh8-binned",
+            "8-wide BVH collapsed from the bvh-binned tree, SSE box test of 8 children, ordered",
+            None,
+            |_| Bvh8Params::default(),
+        ),
         register::<EmbreeScene>(
             "embree-low",
             "Embree 3 BVH, RTC_BUILD_QUALITY_LOW (fast build)",
