@@ -19,8 +19,10 @@ mod node;
 mod simd;
 mod traverse;
 mod validate;
+pub mod wide;
 
 pub use node::{ChildRef, MAX_DEPTH, Node};
+pub use wide::{Bvh8, Bvh8Params};
 
 use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount};
 use raybench_geom::{MollerTriangle, Ray, TriangleMesh};

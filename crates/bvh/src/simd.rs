@@ -52,6 +52,13 @@ mod imp {
             F4(unsafe { _mm_max_ps(self.0, keep.0) })
         }
 
+        /// Lane-wise `if self < keep { self } else { keep }`: `keep` wins when either is NaN.
+        #[inline(always)]
+        pub fn min_keep(self, keep: F4) -> F4 {
+            // SAFETY: SSE is enabled on every x86-64 target; register-only arithmetic.
+            F4(unsafe { _mm_min_ps(self.0, keep.0) })
+        }
+
         /// `[c, d, a, b]` from `[a, b, c, d]`.
         #[inline(always)]
         pub fn swap_halves(self) -> F4 {
@@ -127,6 +134,16 @@ mod imp {
         pub fn max_keep(self, keep: F4) -> F4 {
             F4(std::array::from_fn(|i| {
                 if self.0[i] > keep.0[i] {
+                    self.0[i]
+                } else {
+                    keep.0[i]
+                }
+            }))
+        }
+        #[inline(always)]
+        pub fn min_keep(self, keep: F4) -> F4 {
+            F4(std::array::from_fn(|i| {
+                if self.0[i] < keep.0[i] {
                     self.0[i]
                 } else {
                     keep.0[i]

@@ -120,7 +120,7 @@ impl Ray {
             if v.is_nan() {
                 return Err(RayError::NaN(name));
             }
-            if !(v.abs() <= EMBREE_LARGE) {
+            if v.abs() > EMBREE_LARGE {
                 return Err(RayError::TooLarge(name, v));
             }
         }

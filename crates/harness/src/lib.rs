@@ -2,9 +2,12 @@
 //! validates every ray against a reference, and writes `report.json`.
 #![forbid(unsafe_code)]
 
+pub mod compare;
 pub mod env;
+pub mod images;
 pub mod measure;
 pub mod registry;
+pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene_cmd;

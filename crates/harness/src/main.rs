@@ -32,6 +32,34 @@ enum Command {
     /// Look at scenes: list generators and views, export as OBJ, render a preview PNG.
     #[command(subcommand)]
     Scene(SceneCommand),
+    /// Draw a report: SVG charts, per-pixel PNG pictures and index.html (from report.json alone).
+    Report(ReportArgs),
+    /// Compare two reports: a Markdown table of changes; exit 2 on a regression (a mismatch
+    /// rose, a deterministic figure changed, a timing ratio worsened beyond --max-slowdown).
+    Compare(CompareArgs),
+}
+
+#[derive(Args, Debug)]
+struct ReportArgs {
+    /// The report.json to draw.
+    report: PathBuf,
+    /// Output directory (default: the report's own directory).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+struct CompareArgs {
+    /// The baseline report.json.
+    base: PathBuf,
+    /// The report.json to judge.
+    new: PathBuf,
+    /// A timing ratio to the reference worse by more than this percentage is a regression.
+    #[arg(long, default_value_t = 10.0)]
+    max_slowdown: f64,
+    /// Print timing slowdowns without failing on them (for CI on shared machines).
+    #[arg(long)]
+    timing_advisory: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -139,7 +167,56 @@ fn real_main() -> Result<ExitCode> {
         Command::List => list().map(|_| ExitCode::SUCCESS),
         Command::Run(args) => run_command(args),
         Command::Scene(cmd) => scene_command(cmd).map(|_| ExitCode::SUCCESS),
+        Command::Compare(args) => compare_command(args),
+        Command::Report(args) => report_command(args).map(|_| ExitCode::SUCCESS),
     }
+}
+
+fn report_command(args: ReportArgs) -> Result<()> {
+    let report = raybench_harness::report::Report::read(&args.report)?;
+    let dir = match args.out {
+        Some(d) => d,
+        None => args
+            .report
+            .parent()
+            .map(|p| p.to_path_buf())
+            .unwrap_or_else(|| PathBuf::from(".")),
+    };
+    print_rendered(&raybench_harness::render::render(&report, &dir)?);
+    Ok(())
+}
+
+fn print_rendered(r: &raybench_harness::render::Rendered) {
+    println!(
+        "page: {} ({} charts, {} images)",
+        r.index.display(),
+        r.charts.len(),
+        r.images.len()
+    );
+}
+
+fn compare_command(args: CompareArgs) -> Result<ExitCode> {
+    use raybench_harness::compare::{CompareOptions, compare};
+    use raybench_harness::report::Report;
+    anyhow::ensure!(
+        args.max_slowdown.is_finite() && args.max_slowdown >= 0.0,
+        "--max-slowdown must be a percentage >= 0 (got {})",
+        args.max_slowdown
+    );
+    let base = Report::read(&args.base)?;
+    let new = Report::read(&args.new)?;
+    let opts = CompareOptions {
+        max_slowdown: args.max_slowdown / 100.0,
+        timing_advisory: args.timing_advisory,
+    };
+    let c = compare(&base, &new, &opts);
+    print!("{}", c.markdown);
+    Ok(if c.regressions() > 0 {
+        eprintln!("raybench compare: {} regression(s)", c.regressions());
+        ExitCode::from(2)
+    } else {
+        ExitCode::SUCCESS
+    })
 }
 
 fn scene_command(cmd: SceneCommand) -> Result<()> {
@@ -293,6 +370,11 @@ fn run_command(args: RunArgs) -> Result<ExitCode> {
     let path = report.write_atomic(&dir)?;
     print!("{}", summary_table(&report));
     println!("report: {}", path.display());
+    // The report is safe on disk first: a drawing failure is reported, never loses it.
+    match raybench_harness::render::render(&report, &dir) {
+        Ok(r) => print_rendered(&r),
+        Err(e) => eprintln!("raybench: drawing the report failed: {e:#}"),
+    }
     Ok(if report.mismatches() > 0 {
         eprintln!(
             "raybench: {} mismatches against {}",
@@ -334,6 +416,19 @@ fn join_spec_parameters(pieces: &[String]) -> Vec<String> {
     specs
 }
 
+/// Explicit flags win, then the suite's value, then the default.
+fn pick<T>(
+    explicit: Vec<T>,
+    from_suite: Option<Vec<T>>,
+    default: impl FnOnce() -> Vec<T>,
+) -> Vec<T> {
+    if !explicit.is_empty() {
+        explicit
+    } else {
+        from_suite.unwrap_or_else(default)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::join_spec_parameters;
@@ -358,18 +453,5 @@ mod tests {
                 "a/b=c.obj"
             ]
         );
-    }
-}
-
-/// Explicit flags win, then the suite's value, then the default.
-fn pick<T>(
-    explicit: Vec<T>,
-    from_suite: Option<Vec<T>>,
-    default: impl FnOnce() -> Vec<T>,
-) -> Vec<T> {
-    if !explicit.is_empty() {
-        explicit
-    } else {
-        from_suite.unwrap_or_else(default)
     }
 }

@@ -27,7 +27,7 @@ pub fn median_min_max(samples: &[f64]) -> (f64, f64, f64) {
     let mut s = samples.to_vec();
     s.sort_by(f64::total_cmp);
     let mid = s.len() / 2;
-    let median = if s.len() % 2 == 0 {
+    let median = if s.len().is_multiple_of(2) {
         (s[mid - 1] + s[mid]) / 2.0
     } else {
         s[mid]
@@ -159,22 +159,41 @@ pub fn time_traces(
 }
 
 /// The untimed counting walk, single-threaded so the counters are deterministic.
-pub fn count_pass(accel: &dyn Accel, rays: &[Ray], any_hit: bool) -> (Answers, Counters) {
+/// The counted walk over every ray, single-threaded (counters are exact, not timed). Also
+/// returns each ray's work (interior nodes + leaves + triangle tests + cells), for the
+/// traversal-cost images.
+pub fn count_pass(accel: &dyn Accel, rays: &[Ray], any_hit: bool) -> (Answers, Counters, Vec<u32>) {
     let mut c = Counters::default();
+    let mut per_ray = Vec::with_capacity(rays.len());
+    let work = |c: &Counters| c.nodes + c.leaves + c.prim_tests + c.cells;
+    let mut before = 0;
+    let mut note = |c: &Counters| {
+        let now = work(c);
+        per_ray.push((now - before).min(u32::MAX as u64) as u32);
+        before = now;
+    };
     let answers = if any_hit {
         Answers::Any(
             rays.iter()
-                .map(|r| accel.occluded_counted(r, &mut c))
+                .map(|r| {
+                    let a = accel.occluded_counted(r, &mut c);
+                    note(&c);
+                    a
+                })
                 .collect(),
         )
     } else {
         Answers::Closest(
             rays.iter()
-                .map(|r| accel.intersect_counted(r, &mut c))
+                .map(|r| {
+                    let h = accel.intersect_counted(r, &mut c);
+                    note(&c);
+                    h
+                })
                 .collect(),
         )
     };
-    (answers, c)
+    (answers, c, per_ray)
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! (see README, "Adding a structure").
 
 use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
-use raybench_bvh::{Bvh, BvhParams};
+use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
 use raybench_grid::{Grid, GridParams};
@@ -132,6 +132,12 @@ pub fn registry() -> Vec<StructureEntry> {
             "the bvh-binned tree traversed in fixed child order (what ordering saves)",
             None,
             |_| BvhParams::binned_unordered(),
+        ),
+        register::<Bvh8>(
+            "bvh8-binned",
+            "8-wide BVH collapsed from the bvh-binned tree, SSE box test of 8 children, ordered",
+            None,
+            |_| Bvh8Params::default(),
         ),
         register::<KdTree>(
             "kd-sah",

@@ -91,6 +91,9 @@ pub struct ResultEntry {
     pub memory: Memory,
     pub build_stats: BuildStats,
     pub workloads: Vec<WorkloadResult>,
+    /// Per-pixel pictures of the primary workload (absent when it was not run).
+    #[serde(default)]
+    pub primary_image: Option<crate::images::PrimaryImage>,
 }
 
 /// Wall-clock build time over `runs` builds after one warm-up build.

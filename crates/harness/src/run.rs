@@ -2,6 +2,7 @@
 //! time every structure, count, validate, and assemble the report.
 
 use crate::env::Environment;
+use crate::images::{PixelInput, PrimaryImage, shade};
 use crate::measure::{Answers, count_pass, time_builds, time_traces};
 use crate::registry::{self, BuildContext, StructureEntry};
 use crate::report::*;
@@ -385,6 +386,7 @@ impl<'a> SceneRun<'a> {
         let (built, build) = time_builds(entry, &s.mesh, &ctx, opts.build_runs)?;
         let accel = built.accel.as_ref();
         let mut workloads = Vec::new();
+        let mut primary_image = None;
         for wl in self.workloads.iter().filter(|w| !w.rays.is_empty()) {
             let any_hit = wl.workload.any_hit();
             let prepared = accel.prepare_rays(&wl.rays).map_err(|e| {
@@ -402,15 +404,26 @@ impl<'a> SceneRun<'a> {
                 opts.threads,
                 opts.trace_runs,
             );
-            let (counted, counters) = count_pass(accel, &wl.rays, any_hit);
+            let (counted, counters, work) = count_pass(accel, &wl.rays, any_hit);
             let sides = Sides {
                 ours: accel,
                 reference: self.reference.as_ref(),
                 reference_name: &self.reference_name,
             };
-            let mut validation = validate(&s.mesh, &wl.rays, &answers, &wl.reference, &sides, tol);
+            let (mut validation, levels) =
+                validate(&s.mesh, &wl.rays, &answers, &wl.reference, &sides, tol);
             validation.counted_path_differs = count_differences(&answers, &counted);
             let has_counters = accel.has_counters();
+            if let (Some((w, h)), Answers::Closest(hits)) = (wl.size, &answers) {
+                let pixels: Vec<PixelInput> = (0..wl.rays.len())
+                    .map(|i| PixelInput {
+                        cost: has_counters.then_some(work[i]),
+                        shade: shade(&s.mesh, &wl.rays[i], hits[i].as_ref()),
+                        disagree: levels[i],
+                    })
+                    .collect();
+                primary_image = Some(PrimaryImage::new(w, h, &pixels));
+            }
             workloads.push(WorkloadResult {
                 workload: wl.workload.name().to_string(),
                 rays: wl.rays.len(),
@@ -435,6 +448,7 @@ impl<'a> SceneRun<'a> {
             memory,
             build_stats: accel.build_stats(),
             workloads,
+            primary_image,
         })
     }
 }

@@ -105,6 +105,14 @@ pub fn summary_table(report: &Report) -> String {
     out
 }
 
+fn truncate(s: &str, n: usize) -> String {
+    if s.chars().count() <= n {
+        s.to_string()
+    } else {
+        s.chars().take(n - 1).chain(['~']).collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -113,13 +121,5 @@ mod tests {
         assert_eq!(super::sig(24.863), "24.9");
         assert_eq!(super::sig(1.0), "1.00");
         assert_eq!(super::sig(1234.5), "1234");
-    }
-}
-
-fn truncate(s: &str, n: usize) -> String {
-    if s.chars().count() <= n {
-        s.to_string()
-    } else {
-        s.chars().take(n - 1).chain(['~']).collect()
     }
 }

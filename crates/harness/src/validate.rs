@@ -16,7 +16,7 @@ pub struct Sides<'a> {
     pub reference_name: &'a str,
 }
 
-/// Classifies every ray. Any-hit disagreements are arbitrated through both sides' closest hits,
+/// Classifies every ray; also returns each ray's disagreement level (see [`disagreement`]). Any-hit disagreements are arbitrated through both sides' closest hits,
 /// computed for the disputed rays only.
 impl std::fmt::Debug for Sides<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -34,8 +34,9 @@ pub fn validate(
     reference: &Answers,
     sides: &Sides<'_>,
     tol: &Tolerance,
-) -> Validation {
+) -> (Validation, Vec<u8>) {
     let mut counts = VerdictCounts::default();
+    let mut levels = Vec::with_capacity(rays.len());
     let mut mismatches = Vec::new();
     let mut ambiguous = Vec::new();
     for (i, ray) in rays.iter().enumerate() {
@@ -57,6 +58,7 @@ pub fn validate(
             _ => unreachable!("answers of one workload share a kind"),
         };
         counts.add(verdict);
+        levels.push(disagreement(verdict));
         let bucket = match verdict {
             Verdict::Mismatch => &mut mismatches,
             Verdict::Boundary | Verdict::EdgeAmbiguous => &mut ambiguous,
@@ -69,7 +71,17 @@ pub fn validate(
     let mut v = Validation::new(sides.reference_name, counts);
     v.first_mismatches = mismatches;
     v.first_ambiguous = ambiguous;
-    v
+    (v, levels)
+}
+
+/// For the "disagrees with the reference" image: 0 agrees, 1 differs for an explained reason,
+/// 2 a mismatch.
+fn disagreement(v: Verdict) -> u8 {
+    match v {
+        Verdict::BothMiss | Verdict::Exact | Verdict::WithinTolerance => 0,
+        Verdict::Tie | Verdict::Boundary | Verdict::EdgeAmbiguous => 1,
+        Verdict::Mismatch => 2,
+    }
 }
 
 pub fn verdict_name(v: Verdict) -> &'static str {

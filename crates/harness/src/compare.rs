@@ -1,0 +1,462 @@
+//! `raybench compare BASE.json NEW.json`: what changed between two reports, as a Markdown table
+//! for CI logs, and whether it is a regression.
+//!
+//! Three kinds of figure, gated differently:
+//! * **correctness** — mismatches (plus counted-path disagreements) per scene × structure ×
+//!   workload: any rise fails, on any machine;
+//! * **deterministic figures** — counters per ray, SAH cost, nodes, leaves, references, depth:
+//!   the same seed gives the same numbers on every machine and thread count, so any change
+//!   fails (it is a change of algorithm, and the baseline must be regenerated on purpose);
+//! * **timing** — only as ratios to the reference measured in the same run (build time ratio,
+//!   Mrays/s ratio), which cancels most of the machine; a ratio worse by more than
+//!   `max_slowdown` fails unless timing is advisory (CI shares its machine).
+//!
+//! Entries in the base that the new report lacks fail too (a structure that stopped building is
+//! not "no regression"); entries only in the new report are listed as new.
+
+use crate::report::{Report, ResultEntry, WorkloadResult};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// How to judge timing ratios.
+#[derive(Clone, Copy, Debug)]
+pub struct CompareOptions {
+    /// A ratio to the reference worse by more than this fraction is a slowdown (0.10 = 10 %).
+    pub max_slowdown: f64,
+    /// Print slowdowns but do not fail on them.
+    pub timing_advisory: bool,
+}
+
+impl Default for CompareOptions {
+    fn default() -> Self {
+        CompareOptions {
+            max_slowdown: 0.10,
+            timing_advisory: false,
+        }
+    }
+}
+
+/// What kind of problem a finding is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Severity {
+    /// Fails the comparison.
+    Regression,
+    /// A slowdown beyond the threshold with timing advisory.
+    Advisory,
+    /// Worth knowing (different machine, new entries, improvements).
+    Note,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Finding {
+    pub severity: Severity,
+    pub what: String,
+}
+
+/// The result of a comparison: the Markdown to print and the findings.
+#[derive(Debug)]
+pub struct Comparison {
+    pub markdown: String,
+    pub findings: Vec<Finding>,
+}
+
+impl Comparison {
+    pub fn regressions(&self) -> usize {
+        self.findings
+            .iter()
+            .filter(|f| f.severity == Severity::Regression)
+            .count()
+    }
+}
+
+type Key = (String, String);
+
+fn keyed(report: &Report) -> BTreeMap<Key, &ResultEntry> {
+    report
+        .results
+        .iter()
+        .map(|r| ((r.scene.clone(), r.structure.clone()), r))
+        .collect()
+}
+
+pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison {
+    let mut findings = Vec::new();
+    let comparable = environment_warnings(base, new, &mut findings);
+    for e in &new.errors {
+        findings.push(Finding {
+            severity: Severity::Regression,
+            what: format!("the new report has an error: {e}"),
+        });
+    }
+    // Shadow, diffuse and Whitted rays are generated from the reference's hits: with another
+    // Embree build or ISA they may differ by an ulp, and so may the counters they produce.
+    let same_embree = base.environment.embree.version == new.environment.embree.version
+        && base.environment.embree.isa == new.environment.embree.isa;
+    let (b, n) = (keyed(base), keyed(new));
+    let mut rows = Vec::new();
+    for (key, be) in &b {
+        let Some(ne) = n.get(key) else {
+            findings.push(Finding {
+                severity: Severity::Regression,
+                what: format!(
+                    "{} / {}: in the base, missing from the new report",
+                    key.0, key.1
+                ),
+            });
+            continue;
+        };
+        if comparable {
+            compare_build_stats(be, ne, &mut findings);
+        }
+        compare_build_time(be, ne, opts, &mut findings);
+        for bw in &be.workloads {
+            let Some(nw) = ne.workloads.iter().find(|w| w.workload == bw.workload) else {
+                findings.push(Finding {
+                    severity: Severity::Regression,
+                    what: format!(
+                        "{} / {} / {}: workload missing from the new report",
+                        key.0, key.1, bw.workload
+                    ),
+                });
+                continue;
+            };
+            let label = format!("{} / {} / {}", key.0, key.1, bw.workload);
+            let is_reference = key.1 == new.run.reference;
+            let independent_rays = matches!(bw.workload.as_str(), "primary" | "random");
+            let gate_counters = comparable && (same_embree || independent_rays);
+            compare_workload(
+                &label,
+                bw,
+                nw,
+                gate_counters,
+                is_reference,
+                opts,
+                &mut findings,
+            );
+            rows.push(row(be, ne, bw, nw, comparable));
+        }
+    }
+    for key in n.keys().filter(|k| !b.contains_key(*k)) {
+        findings.push(Finding {
+            severity: Severity::Note,
+            what: format!("{} / {}: new in this report (no baseline)", key.0, key.1),
+        });
+    }
+    findings.sort_by_key(|f| f.severity);
+    let markdown = markdown(base, new, &rows, &findings, opts);
+    Comparison { markdown, findings }
+}
+
+/// Warns about different machines and settings; returns whether deterministic figures are
+/// comparable (same seed, rays, workloads, suite and reference).
+fn environment_warnings(base: &Report, new: &Report, findings: &mut Vec<Finding>) -> bool {
+    let (be, ne) = (&base.environment, &new.environment);
+    let machine = [
+        ("CPU", be.cpu_model.clone(), ne.cpu_model.clone()),
+        ("cores", be.cores.to_string(), ne.cores.to_string()),
+        ("threads", be.threads.to_string(), ne.threads.to_string()),
+        (
+            "Embree",
+            be.embree.version.clone(),
+            ne.embree.version.clone(),
+        ),
+        ("Embree ISA", be.embree.isa.clone(), ne.embree.isa.clone()),
+        ("rustc", be.rustc.clone(), ne.rustc.clone()),
+        ("profile", be.profile.clone(), ne.profile.clone()),
+        ("MXCSR", be.mxcsr.clone(), ne.mxcsr.clone()),
+    ];
+    for (what, b, n) in machine {
+        if b != n {
+            findings.push(Finding {
+                severity: Severity::Note,
+                what: format!(
+                    "WARNING: different environments ({what}: base `{b}`, new `{n}`): timing ratios \
+                     are less comparable"
+                ),
+            });
+        }
+    }
+    let (br, nr) = (&base.run, &new.run);
+    let settings = [
+        ("seed", br.seed.to_string(), nr.seed.to_string()),
+        ("rays", br.rays.to_string(), nr.rays.to_string()),
+        ("reference", br.reference.clone(), nr.reference.clone()),
+        ("workloads", br.workloads.join(","), nr.workloads.join(",")),
+    ];
+    let mut comparable = true;
+    for (what, b, n) in settings {
+        if b != n {
+            comparable = false;
+            findings.push(Finding {
+                severity: Severity::Regression,
+                what: format!(
+                    "different run settings ({what}: base `{b}`, new `{n}`): deterministic figures \
+                     cannot be compared; regenerate the baseline with the same settings"
+                ),
+            });
+        }
+    }
+    comparable
+}
+
+fn compare_build_stats(b: &ResultEntry, n: &ResultEntry, findings: &mut Vec<Finding>) {
+    let (bs, ns) = (&b.build_stats, &n.build_stats);
+    let figures: [(&str, Option<f64>, Option<f64>); 5] = [
+        ("nodes", Some(bs.nodes as f64), Some(ns.nodes as f64)),
+        ("leaves", Some(bs.leaves as f64), Some(ns.leaves as f64)),
+        ("refs", Some(bs.refs as f64), Some(ns.refs as f64)),
+        (
+            "max_depth",
+            Some(bs.max_depth as f64),
+            Some(ns.max_depth as f64),
+        ),
+        ("sah_cost", bs.sah_cost, ns.sah_cost),
+    ];
+    for (what, x, y) in figures {
+        if x != y {
+            findings.push(Finding {
+                severity: Severity::Regression,
+                what: format!(
+                    "{} / {}: {what} changed from {} to {} (deterministic)",
+                    b.scene,
+                    b.structure,
+                    show(x),
+                    show(y)
+                ),
+            });
+        }
+    }
+}
+
+fn show(x: Option<f64>) -> String {
+    x.map_or("-".into(), |v| format!("{v}"))
+}
+
+fn compare_build_time(
+    b: &ResultEntry,
+    n: &ResultEntry,
+    opts: &CompareOptions,
+    findings: &mut Vec<Finding>,
+) {
+    // Lower is better: new / base - 1 is the slowdown.
+    if let (Some(x), Some(y)) = (b.build_ratio_to_reference, n.build_ratio_to_reference)
+        && b.structure != reference_name(b)
+        && x > 0.0
+    {
+        timing_finding(
+            &format!("{} / {}: build time ratio", b.scene, b.structure),
+            x,
+            y,
+            y / x - 1.0,
+            opts,
+            findings,
+        );
+    }
+}
+
+fn reference_name(e: &ResultEntry) -> String {
+    e.workloads
+        .first()
+        .map(|w| w.validation.reference.clone())
+        .unwrap_or_default()
+}
+
+fn compare_workload(
+    label: &str,
+    b: &WorkloadResult,
+    n: &WorkloadResult,
+    gate_counters: bool,
+    is_reference: bool,
+    opts: &CompareOptions,
+    findings: &mut Vec<Finding>,
+) {
+    let bad = |w: &WorkloadResult| w.validation.counts.mismatch + w.validation.counted_path_differs;
+    if bad(n) > bad(b) {
+        findings.push(Finding {
+            severity: Severity::Regression,
+            what: format!("{label}: mismatches rose from {} to {}", bad(b), bad(n)),
+        });
+    }
+    if gate_counters && b.counters_total != n.counters_total {
+        findings.push(Finding {
+            severity: Severity::Regression,
+            what: format!(
+                "{label}: counters changed (deterministic): {} -> {}",
+                counters_text(b),
+                counters_text(n)
+            ),
+        });
+    }
+    // Higher is better: base / new - 1 is the slowdown.
+    if let (Some(x), Some(y)) = (b.speedup_vs_reference, n.speedup_vs_reference)
+        && !is_reference
+    {
+        timing_finding(
+            &format!("{label}: Mrays/s ratio"),
+            x,
+            y,
+            x / y - 1.0,
+            opts,
+            findings,
+        );
+    }
+}
+
+fn counters_text(w: &WorkloadResult) -> String {
+    match &w.counters_per_ray {
+        None => "none".into(),
+        Some(c) => format!(
+            "nodes {:.3}, leaves {:.3}, prim tests {:.3}, cells {:.3}, mailbox skips {:.3} per ray",
+            c.nodes, c.leaves, c.prim_tests, c.cells, c.mailbox_skips
+        ),
+    }
+}
+
+fn timing_finding(
+    label: &str,
+    base: f64,
+    new: f64,
+    slowdown: f64,
+    opts: &CompareOptions,
+    findings: &mut Vec<Finding>,
+) {
+    if slowdown > opts.max_slowdown {
+        findings.push(Finding {
+            severity: if opts.timing_advisory {
+                Severity::Advisory
+            } else {
+                Severity::Regression
+            },
+            what: format!(
+                "{label} {base:.3} -> {new:.3}: {:.1} % slower (threshold {:.0} %)",
+                slowdown * 100.0,
+                opts.max_slowdown * 100.0
+            ),
+        });
+    }
+}
+
+/// One table row: scene, structure, workload and the figures side by side.
+struct Row {
+    scene: String,
+    structure: String,
+    workload: String,
+    speed: (Option<f64>, Option<f64>),
+    build: (Option<f64>, Option<f64>),
+    counters: &'static str,
+    mismatches: (u64, u64),
+}
+
+fn row(
+    be: &ResultEntry,
+    ne: &ResultEntry,
+    bw: &WorkloadResult,
+    nw: &WorkloadResult,
+    comparable: bool,
+) -> Row {
+    Row {
+        scene: be.scene.clone(),
+        structure: be.structure.clone(),
+        workload: bw.workload.clone(),
+        speed: (bw.speedup_vs_reference, nw.speedup_vs_reference),
+        build: (be.build_ratio_to_reference, ne.build_ratio_to_reference),
+        counters: match (&bw.counters_total, comparable) {
+            (None, _) => "-",
+            (_, false) => "not comparable",
+            (Some(_), true) if bw.counters_total == nw.counters_total => "same",
+            _ => "CHANGED",
+        },
+        mismatches: (
+            bw.validation.counts.mismatch + bw.validation.counted_path_differs,
+            nw.validation.counts.mismatch + nw.validation.counted_path_differs,
+        ),
+    }
+}
+
+fn ratio_cell((b, n): (Option<f64>, Option<f64>), higher_is_better: bool) -> String {
+    match (b, n) {
+        (Some(b), Some(n)) => {
+            let change = if higher_is_better {
+                n / b - 1.0
+            } else {
+                b / n - 1.0
+            };
+            format!("{b:.3} → {n:.3} ({:+.1} %)", change * 100.0)
+        }
+        _ => "-".into(),
+    }
+}
+
+fn markdown(
+    base: &Report,
+    new: &Report,
+    rows: &[Row],
+    findings: &[Finding],
+    opts: &CompareOptions,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "## raybench compare\n\nbase: {} ({}), new: {} ({})\n",
+        base.environment.git_revision,
+        base.environment.timestamp,
+        new.environment.git_revision,
+        new.environment.timestamp
+    );
+    let _ = writeln!(
+        s,
+        "Ratios are to `{}` in the same run (speed: higher is better; build: lower is better); \
+         the change is positive when the new report is better. Timing threshold {:.0} %{}.\n",
+        new.run.reference,
+        opts.max_slowdown * 100.0,
+        if opts.timing_advisory {
+            ", advisory"
+        } else {
+            ""
+        }
+    );
+    s.push_str(
+        "| scene | structure | workload | speed ratio | build ratio | counters | mismatches |\n",
+    );
+    s.push_str("|---|---|---|---:|---:|---|---:|\n");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} → {} |",
+            r.scene,
+            r.structure,
+            r.workload,
+            ratio_cell(r.speed, true),
+            ratio_cell(r.build, false),
+            r.counters,
+            r.mismatches.0,
+            r.mismatches.1
+        );
+    }
+    let regressions = findings
+        .iter()
+        .filter(|f| f.severity == Severity::Regression)
+        .count();
+    let _ = writeln!(
+        s,
+        "\n{} regression(s), {} advisory, {} note(s).",
+        regressions,
+        findings
+            .iter()
+            .filter(|f| f.severity == Severity::Advisory)
+            .count(),
+        findings
+            .iter()
+            .filter(|f| f.severity == Severity::Note)
+            .count()
+    );
+    for f in findings {
+        let tag = match f.severity {
+            Severity::Regression => "REGRESSION",
+            Severity::Advisory => "advisory",
+            Severity::Note => "note",
+        };
+        let _ = writeln!(s, "- **{tag}**: {}", f.what);
+    }
+    s
+}

@@ -1,0 +1,254 @@
+//! `index.html`: one static page (no JavaScript) with the tables, charts, pictures and the
+//! environment fingerprint of a report.
+
+use super::{ChartFile, ScenePictures, scene_names, structure_names, workload_names};
+use crate::report::Report;
+use std::fmt::Write as _;
+
+pub(crate) fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+const STYLE: &str = "body{font-family:sans-serif;margin:24px;color:#222;max-width:1300px}\
+table{border-collapse:collapse;margin:12px 0;font-size:13px}\
+th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}\
+th{background:#f0f0f0}td.l,th.l{text-align:left}\
+figure{margin:18px 0}figcaption{font-size:13px;color:#444}\
+img.chart{max-width:100%;border:1px solid #ddd}\
+img.px{image-rendering:pixelated;width:240px;border:1px solid #ddd}\
+.bad{color:#c00;font-weight:bold}.note{color:#555;font-size:13px}";
+
+pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictures]) -> String {
+    let mut s = String::new();
+    let env = &report.environment;
+    let title = match &report.run.suite {
+        Some(suite) => format!("raybench: suite {suite}"),
+        None => "raybench report".to_string(),
+    };
+    let _ = write!(
+        s,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title>\
+         <style>{STYLE}</style></head><body>\n<h1>{}</h1>\n<p class=\"note\">{} at revision {}, \
+         {} thread(s), seed {}, {} rays per workload; every answer checked against <b>{}</b>.</p>\n",
+        escape(&title),
+        escape(&title),
+        escape(&env.timestamp),
+        escape(&env.git_revision),
+        report.run.threads,
+        report.run.seed,
+        report.run.rays,
+        escape(&report.run.reference)
+    );
+    let mismatches = report.mismatches();
+    let _ = writeln!(
+        s,
+        "<p class=\"{}\">{} mismatches in {} validated rays.</p>",
+        if mismatches > 0 { "bad" } else { "note" },
+        mismatches,
+        report
+            .results
+            .iter()
+            .flat_map(|r| &r.workloads)
+            .map(|w| w.validation.rays())
+            .sum::<u64>()
+    );
+    results_table(&mut s, report);
+    validation_table(&mut s, report);
+    s.push_str("<h2>Charts</h2>\n");
+    for c in charts {
+        let _ = writeln!(
+            s,
+            "<figure><img class=\"chart\" src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
+            escape(&c.file),
+            escape(&c.caption),
+            escape(&c.caption)
+        );
+    }
+    pictures_section(&mut s, pictures);
+    notes(&mut s, report);
+    environment(&mut s, report);
+    s.push_str("</body></html>\n");
+    s
+}
+
+fn results_table(s: &mut String, report: &Report) {
+    let workloads = workload_names(report);
+    s.push_str(
+        "<h2>Results</h2>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">structure</th>\
+                <th>triangles</th><th>build ms (× ref)</th><th>bytes / triangle</th><th>SAH</th>",
+    );
+    for w in &workloads {
+        let _ = write!(s, "<th>{} Mrays/s (× ref)</th>", escape(w));
+    }
+    s.push_str("<th>mismatches</th></tr>\n");
+    for scene in scene_names(report) {
+        for st in structure_names(report) {
+            let Some(r) = report
+                .results
+                .iter()
+                .find(|r| r.scene == scene && r.structure == st)
+            else {
+                continue;
+            };
+            let _ = write!(
+                s,
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{:.1} ({})</td>\
+                 <td>{:.1}</td><td>{}</td>",
+                escape(&scene),
+                escape(&st),
+                r.triangles.traced,
+                r.build.median_ms,
+                ratio(r.build_ratio_to_reference),
+                r.memory_bytes as f64 / r.triangles.traced.max(1) as f64,
+                r.build_stats
+                    .sah_cost
+                    .map_or("-".into(), |c| format!("{c:.2}"))
+            );
+            for w in &workloads {
+                match r.workloads.iter().find(|x| &x.workload == w) {
+                    Some(x) => {
+                        let _ = write!(
+                            s,
+                            "<td>{:.2} ({})</td>",
+                            x.mrays_per_s.median,
+                            ratio(x.speedup_vs_reference)
+                        );
+                    }
+                    None => s.push_str("<td>-</td>"),
+                }
+            }
+            let bad: u64 = r
+                .workloads
+                .iter()
+                .map(|w| w.validation.counts.mismatch + w.validation.counted_path_differs)
+                .sum();
+            let _ = writeln!(
+                s,
+                "<td{}>{bad}</td></tr>",
+                if bad > 0 { " class=\"bad\"" } else { "" }
+            );
+        }
+    }
+    s.push_str("</table>\n");
+}
+
+fn ratio(r: Option<f64>) -> String {
+    r.map_or("-".into(), |r| format!("{r:.2}×"))
+}
+
+fn validation_table(s: &mut String, report: &Report) {
+    s.push_str(
+        "<h2>Validation</h2>\n<table><tr><th class=\"l\">structure</th><th>rays</th><th>both miss</th>\
+         <th>exact</th><th>within tolerance</th><th>tie</th><th>boundary</th><th>edge ambiguous</th>\
+         <th>mismatch</th><th>counted path differs</th></tr>\n",
+    );
+    for st in structure_names(report) {
+        let mut c = raybench_accel::compare::VerdictCounts::default();
+        let mut differs = 0;
+        for w in report
+            .results
+            .iter()
+            .filter(|r| r.structure == st)
+            .flat_map(|r| &r.workloads)
+        {
+            c += w.validation.counts;
+            differs += w.validation.counted_path_differs;
+        }
+        let _ = writeln!(
+            s,
+            "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>\
+             <td>{}</td><td{}>{}</td><td>{}</td></tr>",
+            escape(&st),
+            c.total(),
+            c.both_miss,
+            c.exact,
+            c.within_tolerance,
+            c.tie,
+            c.boundary,
+            c.edge_ambiguous,
+            if c.mismatch > 0 { " class=\"bad\"" } else { "" },
+            c.mismatch,
+            differs
+        );
+    }
+    s.push_str("</table>\n");
+}
+
+fn pictures_section(s: &mut String, pictures: &[ScenePictures]) {
+    if pictures.is_empty() {
+        return;
+    }
+    s.push_str(
+        "<h2>Primary rays, per pixel</h2>\n<p class=\"note\">Traversal cost is interior nodes + \
+         leaves + triangle tests + cells per pixel, on one logarithmic colour scale per scene (legend below each \
+         scene). The mask shows where the structure disagrees with the reference: amber for an \
+         explained difference (tie, boundary, edge-ambiguous), red for a mismatch.</p>\n",
+    );
+    for p in pictures {
+        let _ = writeln!(
+            s,
+            "<h3>{}</h3>\n<p class=\"note\">cost scale (logarithmic): 0 <img src=\"images/legend-viridis.png\" \
+             alt=\"colour scale\" style=\"vertical-align:middle;width:256px;height:14px\"> {} \
+             (downsampled {}×{} pixels per stored pixel)</p>",
+            escape(&p.scene),
+            p.max_cost,
+            p.downsample,
+            p.downsample
+        );
+        s.push_str("<table><tr><th class=\"l\">structure</th><th>traversal cost</th><th>render</th><th>disagrees with the reference</th></tr>\n");
+        for (st, heat, render, mask) in &p.rows {
+            let heat = heat.as_ref().map_or("not counted".to_string(), |f| {
+                format!("<img class=\"px\" src=\"{}\" alt=\"cost\">", escape(f))
+            });
+            let _ = writeln!(
+                s,
+                "<tr><td class=\"l\">{}</td><td>{heat}</td><td><img class=\"px\" src=\"{}\" alt=\"render\"></td>\
+                 <td><img class=\"px\" src=\"{}\" alt=\"mask\"></td></tr>",
+                escape(st),
+                escape(render),
+                escape(mask)
+            );
+        }
+        s.push_str("</table>\n");
+    }
+}
+
+fn notes(s: &mut String, report: &Report) {
+    if report.notes.is_empty() && report.errors.is_empty() {
+        return;
+    }
+    s.push_str("<h2>Notes and errors</h2>\n<ul>\n");
+    for n in &report.notes {
+        let _ = writeln!(s, "<li>{}</li>", escape(n));
+    }
+    for e in &report.errors {
+        let _ = writeln!(s, "<li class=\"bad\">{}</li>", escape(e));
+    }
+    s.push_str("</ul>\n");
+}
+
+fn environment(s: &mut String, report: &Report) {
+    s.push_str("<h2>Environment</h2>\n<table>\n");
+    let env = serde_json::to_value(&report.environment).unwrap_or_default();
+    let run = serde_json::to_value(&report.run).unwrap_or_default();
+    for (section, value) in [("environment", env), ("run", run)] {
+        if let serde_json::Value::Object(map) = value {
+            for (k, v) in map {
+                let text = match v {
+                    serde_json::Value::String(t) => t,
+                    other => other.to_string(),
+                };
+                let _ = writeln!(
+                    s,
+                    "<tr><td class=\"l\">{section}.{}</td><td class=\"l\">{}</td></tr>",
+                    escape(&k),
+                    escape(&text)
+                );
+            }
+        }
+    }
+    s.push_str("</table>\n");
+}

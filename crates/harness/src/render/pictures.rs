@@ -1,0 +1,123 @@
+//! The per-pixel pictures of a report as PNG: traversal-cost heatmaps on one colour scale per
+//! scene, shaded renders, and "disagrees with the reference" masks. No text is drawn into the
+//! PNGs (that would need fonts); the HTML page labels them and the legend's numbers.
+
+use crate::images::PrimaryImage;
+use crate::scene_cmd::write_png;
+use anyhow::{Result, anyhow};
+use std::path::Path;
+
+/// Viridis at nine stops (from matplotlib's table), interpolated linearly in between.
+const VIRIDIS: [[f32; 3]; 9] = [
+    [68.0, 1.0, 84.0],
+    [71.0, 44.0, 122.0],
+    [59.0, 81.0, 139.0],
+    [44.0, 113.0, 142.0],
+    [33.0, 144.0, 141.0],
+    [39.0, 173.0, 129.0],
+    [92.0, 200.0, 99.0],
+    [170.0, 220.0, 50.0],
+    [253.0, 231.0, 37.0],
+];
+
+/// Colour for `t` in `[0, 1]` (clamped).
+pub fn viridis(t: f64) -> [u8; 3] {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } as f32;
+    let x = t * (VIRIDIS.len() - 1) as f32;
+    let i = (x as usize).min(VIRIDIS.len() - 2);
+    let f = x - i as f32;
+    std::array::from_fn(|c| (VIRIDIS[i][c] * (1.0 - f) + VIRIDIS[i + 1][c] * f).round() as u8)
+}
+
+/// Heatmap pixels on a logarithmic scale: cost 0 is the bottom, `max` the top. Logarithmic
+/// because one scale serves every structure of a scene, and brute force (N tests per pixel)
+/// would otherwise flatten every tree into the bottom colour.
+pub fn heatmap_pixels(img: &PrimaryImage, max: u16) -> Result<Option<Vec<[u8; 3]>>> {
+    let Some(cost) = img.cost_values().map_err(|e| anyhow!(e))? else {
+        return Ok(None);
+    };
+    Ok(Some(
+        cost.iter().map(|&c| viridis(log_scale(c, max))).collect(),
+    ))
+}
+
+/// `ln(1 + c) / ln(1 + max)`: 0 for no work, 1 at the scene's maximum.
+pub fn log_scale(c: u16, max: u16) -> f64 {
+    (1.0 + c as f64).ln() / (1.0 + max.max(1) as f64).ln()
+}
+
+pub fn shade_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
+    let shade = img.shade_values().map_err(|e| anyhow!(e))?;
+    Ok(shade
+        .iter()
+        .map(|&s| {
+            if s == 0 {
+                [34, 40, 49] // miss: dark blue-grey background
+            } else {
+                let v = 40 + (s as u32 * 215 / 255) as u8;
+                [v, v, v]
+            }
+        })
+        .collect())
+}
+
+/// Agreeing pixels as a dim version of the render, explained differences amber, mismatches red.
+pub fn disagree_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
+    let shade = img.shade_values().map_err(|e| anyhow!(e))?;
+    let d = img.disagree_values().map_err(|e| anyhow!(e))?;
+    Ok(shade
+        .iter()
+        .zip(&d)
+        .map(|(&s, &d)| match d {
+            0 => {
+                let v = 20 + (s as u32 * 60 / 255) as u8;
+                [v, v, v]
+            }
+            1 => [255, 191, 0],
+            _ => [230, 20, 20],
+        })
+        .collect())
+}
+
+/// The largest cost of any structure's image of a scene: one colour scale per scene.
+pub fn shared_max(images: &[&PrimaryImage]) -> u16 {
+    images
+        .iter()
+        .filter_map(|i| i.cost_values().ok().flatten())
+        .flat_map(|c| c.into_iter())
+        .max()
+        .unwrap_or(1)
+        .max(1)
+}
+
+/// A horizontal colour bar, 256 × 16, low on the left.
+pub fn write_legend(out: &Path) -> Result<()> {
+    let (w, h) = (256u32, 16u32);
+    let pixels: Vec<[u8; 3]> = (0..h)
+        .flat_map(|_| (0..w).map(|x| viridis(x as f64 / (w - 1) as f64)))
+        .collect();
+    write_png(&pixels, w, h, out)
+}
+
+pub fn write(pixels: &[[u8; 3]], img: &PrimaryImage, out: &Path) -> Result<()> {
+    write_png(pixels, img.width, img.height, out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn viridis_runs_from_dark_purple_to_yellow() {
+        assert_eq!(viridis(0.0), [68, 1, 84]);
+        assert_eq!(viridis(1.0), [253, 231, 37]);
+        assert_eq!(viridis(-3.0), viridis(0.0));
+        assert_eq!(viridis(f64::NAN), viridis(0.0));
+        let mid = viridis(0.5);
+        assert_eq!(mid, [33, 144, 141]);
+    }
+}
