@@ -126,7 +126,6 @@ pub struct Bvh {
     root_bounds: raybench_geom::Aabb,
     triangles: Vec<MollerTriangle>,
     prim_ids: Vec<u32>,
-    stats: BuildStats,
 }
 
 impl Bvh {
@@ -166,7 +165,6 @@ impl Accel for Bvh {
         Ok(Bvh {
             name: params.name(),
             params: params.clone(),
-            stats: flat.stats,
             nodes: flat.nodes,
             root: flat.root,
             root_bounds: flat.root_bounds,
@@ -204,7 +202,10 @@ impl Accel for Bvh {
     }
 
     fn build_stats(&self) -> BuildStats {
-        self.stats.clone()
+        if self.triangles.is_empty() {
+            return BuildStats::default();
+        }
+        build::Shape::measure(&self.nodes, self.root, &self.root_bounds)
     }
 
     fn memory(&self) -> Memory {

@@ -104,7 +104,6 @@ pub struct Bvh8 {
     root_bounds: Aabb,
     triangles: Vec<MollerTriangle>,
     prim_ids: Vec<u32>,
-    stats: BuildStats,
 }
 
 /// Collapses the binary subtree `r` into wide nodes appended to `out` depth-first.
@@ -428,17 +427,14 @@ impl Accel for Bvh8 {
             .iter()
             .map(|&i| MollerTriangle::new(&mesh.triangle(i as usize)))
             .collect();
-        let mut bvh = Bvh8 {
+        Ok(Bvh8 {
             params: params.clone(),
             nodes,
             root,
             root_bounds: flat.root_bounds,
             triangles,
             prim_ids: flat.prim_ids,
-            stats: BuildStats::default(),
-        };
-        bvh.stats = bvh.measure();
-        Ok(bvh)
+        })
     }
 
     fn name(&self) -> &str {
@@ -484,7 +480,7 @@ impl Accel for Bvh8 {
     }
 
     fn build_stats(&self) -> BuildStats {
-        self.stats.clone()
+        self.measure()
     }
 
     fn memory(&self) -> Memory {

@@ -35,7 +35,6 @@ use split::{PARALLEL_BINNING, Split, binned_split, median_split, sweep_split};
 pub(crate) struct Flat {
     pub nodes: Vec<Node>,
     pub prim_ids: Vec<u32>,
-    pub stats: BuildStats,
     pub root: ChildRef,
     pub root_bounds: Aabb,
 }
@@ -51,7 +50,6 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
         return Ok(Flat {
             nodes: Vec::new(),
             prim_ids: Vec::new(),
-            stats: BuildStats::default(),
             root: ChildRef::default(),
             root_bounds: Aabb::EMPTY,
         });
@@ -66,11 +64,9 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
     let mut nodes = Vec::with_capacity(n - 1);
     let root = part.flatten(&mut nodes);
     let root_bounds = whole.bounds.to_aabb();
-    let stats = Shape::measure(&nodes, root, &root_bounds);
     Ok(Flat {
         prim_ids: refs.iter().map(PrimRef::id).collect(),
         nodes,
-        stats,
         root,
         root_bounds,
     })
@@ -206,9 +202,11 @@ fn decide(p: &BvhParams, refs: &mut [PrimRef], r: &Ranged, depth: usize) -> Opti
     }
 }
 
-/// Facts measured on the flattened tree (what traversal walks), turned into [`BuildStats`].
+/// Facts measured on the flattened tree (what traversal walks), turned into [`BuildStats`] on
+/// request (`build_stats`), outside the timed build: Embree's build computes no statistics
+/// either.
 #[derive(Default)]
-struct Shape {
+pub(crate) struct Shape {
     nodes: u64,
     leaves: u64,
     refs: u64,
@@ -220,7 +218,7 @@ struct Shape {
 }
 
 impl Shape {
-    fn measure(nodes: &[Node], root: ChildRef, root_bounds: &Aabb) -> BuildStats {
+    pub(crate) fn measure(nodes: &[Node], root: ChildRef, root_bounds: &Aabb) -> BuildStats {
         let mut shape = Shape::default();
         shape.visit(nodes, root, root_bounds, 0, root_bounds.surface_area());
         shape.stats()
