@@ -9,9 +9,11 @@
 mod brute;
 pub mod compare;
 mod counters;
+mod mailbox;
 
 pub use brute::{BruteForce, BruteForceParams};
 pub use counters::{CounterSink, Counters, NoCount};
+pub use mailbox::Mailbox;
 pub use raybench_geom as geom;
 
 use raybench_geom::{Ray, TriangleMesh};

@@ -36,27 +36,8 @@ pub(crate) const MAILBOX: usize = 32;
 /// `t0 < t1`, `t0 < t2`, `t1 < t2` (two entries are unreachable).
 const CMP_TO_AXIS: [usize; 8] = [2, 1, 2, 1, 2, 2, 0, 0];
 
-/// Direct-mapped record of the triangles this ray has tested.
-pub(crate) struct Mailbox([u32; MAILBOX]);
-
-impl Mailbox {
-    #[inline(always)]
-    pub(crate) fn new() -> Mailbox {
-        Mailbox([u32::MAX; MAILBOX])
-    }
-
-    /// True when `prim` was tested already (skip it); otherwise records it.
-    #[inline(always)]
-    pub(crate) fn seen(&mut self, prim: u32) -> bool {
-        let slot = &mut self.0[prim as usize % MAILBOX];
-        if *slot == prim {
-            true
-        } else {
-            *slot = prim;
-            false
-        }
-    }
-}
+/// The per-ray record of tested triangles.
+pub(crate) type Mailbox = raybench_accel::Mailbox<MAILBOX>;
 
 impl Grid {
     pub(crate) fn trace<const ANY_HIT: bool, C: CounterSink>(

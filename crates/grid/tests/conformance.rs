@@ -5,7 +5,7 @@
 use raybench_accel::{Accel, BuildError};
 use raybench_geom::{Ray, Triangle, TriangleMesh, Vec3};
 use raybench_grid::{Grid, GridParams};
-use raybench_testkit::{Case, check_case, conformance, seeded_rng};
+use raybench_testkit::{Case, check_case, conformance, lattice_rays, seeded_rng};
 use std::sync::Arc;
 
 fn check(params: GridParams) {
@@ -124,7 +124,7 @@ fn plane_scene() -> (Arc<TriangleMesh>, GridParams) {
         ),
     ];
     let mut rng = seeded_rng(0x5eed_6001);
-    let mut f = move || (rand_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
+    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
     for _ in 0..400 {
         let c = Vec3::new(f(), f(), f()) * 3.6 + 0.2;
         let mut v = || c + (Vec3::new(f(), f(), f()) - 0.5) * 0.3;
@@ -134,75 +134,6 @@ fn plane_scene() -> (Arc<TriangleMesh>, GridParams) {
     // λN = 512 cells over a 4³ box: side 0.5, 8 per axis.
     let params = GridParams::with_density(512.0 / mesh.len() as f64);
     (mesh, params)
-}
-
-fn rand_u32(rng: &mut impl rand_core::Rng) -> u32 {
-    rng.next_u32()
-}
-
-/// Rays along cell planes, edges and through cell corners, axis-parallel with ±0 components,
-/// starting outside, inside, on planes and at grid vertices.
-fn plane_rays() -> Vec<Ray> {
-    let mut rays = Vec::new();
-    let lines: Vec<f32> = (0..=8).map(|k| k as f32 * 0.5).collect();
-    let signs = [(1.0f32, 0.0f32), (-1.0, -0.0)];
-    for &a in &lines {
-        for &b in &lines {
-            for (s, z) in signs {
-                // Along the z axis on the cell edge x = a, y = b: from outside and from inside.
-                rays.push(Ray::infinite(
-                    Vec3::new(a, b, 2.0 - 3.0 * s),
-                    Vec3::new(z, -z, s),
-                ));
-                rays.push(Ray::infinite(Vec3::new(a, b, 2.25), Vec3::new(z, z, s)));
-                // Along x on y = a, z = b, and along y on z = a, x = b.
-                rays.push(Ray::infinite(
-                    Vec3::new(2.0 - 3.0 * s, a, b),
-                    Vec3::new(s, z, z),
-                ));
-                rays.push(Ray::infinite(Vec3::new(b, 1.75, a), Vec3::new(-z, s, z)));
-            }
-            // In the plane x = a (d.x = ±0), oblique in y and z, through cell corners.
-            rays.push(Ray::infinite(
-                Vec3::new(a, -1.0, b - 1.0),
-                Vec3::new(0.0, 1.0, 1.0),
-            ));
-            rays.push(Ray::infinite(
-                Vec3::new(a, 5.0, b + 1.0),
-                Vec3::new(-0.0, -1.0, -1.0),
-            ));
-            // Diagonals through grid vertices, from inside with t_min > 0.
-            rays.push(Ray::new(
-                Vec3::new(a, b, 0.0),
-                Vec3::new(1.0, 1.0, 1.0),
-                0.25,
-                100.0,
-            ));
-            rays.push(Ray::new(
-                Vec3::new(a, b, 4.0),
-                Vec3::new(-1.0, 1.0, -1.0),
-                0.0,
-                3.0,
-            ));
-        }
-    }
-    // From every grid vertex (origin exactly on three planes) in seeded directions.
-    let mut rng = seeded_rng(0x5eed_6002);
-    for &x in lines.iter().step_by(2) {
-        for &y in lines.iter().step_by(2) {
-            for &z in lines.iter().step_by(2) {
-                let d = Vec3::new(
-                    rand_u32(&mut rng) as f32,
-                    rand_u32(&mut rng) as f32,
-                    rand_u32(&mut rng) as f32,
-                ) / u32::MAX as f32
-                    - 0.5;
-                rays.push(Ray::infinite(Vec3::new(x, y, z), d));
-                rays.push(Ray::infinite(Vec3::new(x, y, z), -d));
-            }
-        }
-    }
-    rays
 }
 
 #[test]
@@ -218,7 +149,7 @@ fn rays_along_cell_planes_edges_and_corners() {
         name: "cell-planes".into(),
         seed: 0x5eed_6002,
         mesh,
-        rays: plane_rays(),
+        rays: lattice_rays(),
     };
     let counts =
         check_case::<Grid>(&case, &params, &|g, m| g.validate(m)).unwrap_or_else(|e| panic!("{e}"));
@@ -237,7 +168,7 @@ fn walks_are_bounded_and_counted() {
     assert!(c.cells >= 1 && c.cells <= 8, "{c:?}");
     // The mailbox skips a triangle met again: the big slanted one spans many cells.
     let mut total = raybench_accel::Counters::default();
-    for r in plane_rays() {
+    for r in lattice_rays() {
         grid.intersect_counted(&r, &mut total);
     }
     assert!(total.mailbox_skips > 0, "{total:?}");

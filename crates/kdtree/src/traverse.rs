@@ -83,7 +83,7 @@ impl KdTree {
         let negative = inv.map(f32::is_sign_negative);
         let mut best_t = ray.t_max();
         let mut best: Option<(u32, TriHit)> = None;
-        let mut mailbox = [u32::MAX; MAILBOX_SLOTS];
+        let mut mailbox = raybench_accel::Mailbox::<MAILBOX_SLOTS>::new();
         let mut stack = [(0u32, 0f32, 0f32); STACK];
         let mut sp = 0;
         let mut at = 0u32;
@@ -116,13 +116,9 @@ impl KdTree {
             c.leaf();
             let first = node.first() as usize;
             for &r in &self.refs[first..first + node.count() as usize] {
-                if MAILBOX {
-                    let slot = r as usize & (MAILBOX_SLOTS - 1);
-                    if mailbox[slot] == r {
-                        c.mailbox_skip();
-                        continue;
-                    }
-                    mailbox[slot] = r;
+                if MAILBOX && mailbox.seen(r) {
+                    c.mailbox_skip();
+                    continue;
                 }
                 c.prim_tests(1);
                 if let Some(h) = self.triangles[r as usize].intersect(&ray.with_t_max(best_t)) {

@@ -24,26 +24,7 @@ use raybench_geom::{Ray, TriHit, Vec3};
 /// Mailbox slots (a power of two), as the grid's: 32 ids, 128 bytes per ray, not tuned.
 const MAILBOX: usize = 32;
 
-struct Mailbox([u32; MAILBOX]);
-
-impl Mailbox {
-    #[inline(always)]
-    fn new() -> Mailbox {
-        Mailbox([u32::MAX; MAILBOX])
-    }
-
-    /// True when `prim` was tested already (skip it); otherwise records it.
-    #[inline(always)]
-    fn seen(&mut self, prim: u32) -> bool {
-        let slot = &mut self.0[prim as usize % MAILBOX];
-        if *slot == prim {
-            true
-        } else {
-            *slot = prim;
-            false
-        }
-    }
-}
+type Mailbox = raybench_accel::Mailbox<MAILBOX>;
 
 impl Octree {
     pub(crate) fn trace<const ANY_HIT: bool, C: CounterSink>(

@@ -5,7 +5,7 @@
 use raybench_accel::{Accel, BuildError, Counters};
 use raybench_geom::{Ray, Triangle, TriangleMesh, Vec3};
 use raybench_octree::{Octree, OctreeParams};
-use raybench_testkit::{Case, check_case, conformance, seeded_rng};
+use raybench_testkit::{Case, check_case, conformance, lattice_rays, seeded_rng};
 use std::sync::Arc;
 
 fn check(params: OctreeParams) {
@@ -141,62 +141,6 @@ fn plane_scene() -> Arc<TriangleMesh> {
     Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0)
 }
 
-/// Rays along split planes, octant edges and through octant corners (multiples of 0.5),
-/// axis-parallel with ±0 components, starting outside, inside, on planes and at corners.
-fn plane_rays() -> Vec<Ray> {
-    let mut rays = Vec::new();
-    let lines: Vec<f32> = (0..=8).map(|k| k as f32 * 0.5).collect();
-    let signs = [(1.0f32, 0.0f32), (-1.0, -0.0)];
-    for &a in &lines {
-        for &b in &lines {
-            for (s, z) in signs {
-                rays.push(Ray::infinite(
-                    Vec3::new(a, b, 2.0 - 3.0 * s),
-                    Vec3::new(z, -z, s),
-                ));
-                rays.push(Ray::infinite(Vec3::new(a, b, 2.25), Vec3::new(z, z, s)));
-                rays.push(Ray::infinite(
-                    Vec3::new(2.0 - 3.0 * s, a, b),
-                    Vec3::new(s, z, z),
-                ));
-                rays.push(Ray::infinite(Vec3::new(b, 1.75, a), Vec3::new(-z, s, z)));
-            }
-            rays.push(Ray::infinite(
-                Vec3::new(a, -1.0, b - 1.0),
-                Vec3::new(0.0, 1.0, 1.0),
-            ));
-            rays.push(Ray::infinite(
-                Vec3::new(a, 5.0, b + 1.0),
-                Vec3::new(-0.0, -1.0, -1.0),
-            ));
-            rays.push(Ray::new(
-                Vec3::new(a, b, 0.0),
-                Vec3::new(1.0, 1.0, 1.0),
-                0.25,
-                100.0,
-            ));
-            rays.push(Ray::new(
-                Vec3::new(a, b, 4.0),
-                Vec3::new(-1.0, 1.0, -1.0),
-                0.0,
-                3.0,
-            ));
-        }
-    }
-    let mut rng = seeded_rng(0x5eed_6002);
-    let mut u = move || rand_core::Rng::next_u32(&mut rng) as f32 / u32::MAX as f32 - 0.5;
-    for &x in lines.iter().step_by(2) {
-        for &y in lines.iter().step_by(2) {
-            for &z in lines.iter().step_by(2) {
-                let d = Vec3::new(u(), u(), u());
-                rays.push(Ray::infinite(Vec3::new(x, y, z), d));
-                rays.push(Ray::infinite(Vec3::new(x, y, z), -d));
-            }
-        }
-    }
-    rays
-}
-
 #[test]
 fn rays_along_split_planes_edges_and_corners() {
     let mesh = plane_scene();
@@ -219,7 +163,7 @@ fn rays_along_split_planes_edges_and_corners() {
             name: "split-planes".into(),
             seed: 0x5eed_6002,
             mesh: mesh.clone(),
-            rays: plane_rays(),
+            rays: lattice_rays(),
         };
         let counts = check_case::<Octree>(&case, &params, &|t, m| t.validate(m))
             .unwrap_or_else(|e| panic!("{e}"));
@@ -233,7 +177,7 @@ fn walks_are_bounded_and_counted() {
     let mesh = plane_scene();
     let tree = Octree::build(mesh, &OctreeParams::default()).unwrap();
     let mut total = Counters::default();
-    for r in plane_rays() {
+    for r in lattice_rays() {
         tree.intersect_counted(&r, &mut total);
     }
     assert!(total.mailbox_skips > 0, "{total:?}");

@@ -20,7 +20,7 @@ mod cases;
 mod rays;
 
 pub use cases::{Case, edge_cases, seeded_cases};
-pub use rays::{centroid_rays, random_rays_in, seeded_rng};
+pub use rays::{centroid_rays, lattice_rays, random_rays_in, seeded_rng};
 
 use raybench_accel::compare::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
 use raybench_accel::{Accel, BruteForce, Counters};
