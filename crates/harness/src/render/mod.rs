@@ -2,8 +2,8 @@
 //!
 //! Output layout under the chosen directory:
 //! * `charts/*.svg` — build time, Mrays/s and ratios to the reference per workload, memory per
-//!   triangle, counters per ray, scaling curves with reference slopes (when the report spans
-//!   three or more scene sizes), break-even per scene, validation classes;
+//!   triangle, counters per ray, scaling curves with reference slopes (when one scene family
+//!   comes in three or more sizes), break-even per scene, validation classes;
 //! * `images/*.png` — per scene and structure: traversal-cost heatmap (one colour scale per
 //!   scene), shaded render, disagreement mask; one legend colour bar;
 //! * `index.html` — tables, the charts, the pictures and the environment; no JavaScript.
@@ -321,20 +321,47 @@ type Curve = (&'static str, fn(f64) -> f64);
 /// How many rays of a validation class.
 type ClassCount = fn(&raybench_accel::compare::VerdictCounts) -> u64;
 
-fn scaling_chart(report: &Report) -> Result<Option<String>> {
-    let mut sizes: Vec<u64> = report.results.iter().map(|r| r.triangles.traced).collect();
-    sizes.sort_unstable();
-    sizes.dedup();
-    if sizes.len() < 3 {
-        return Ok(None);
+/// The generator (or file) a scene name comes from: `teapot:triangles=4000` → `teapot`.
+fn family(scene: &str) -> &str {
+    scene.split(':').next().unwrap_or(scene)
+}
+
+/// The scene family with the most distinct sizes, if it has at least three: scaling is only
+/// meaningful along one kind of geometry (the `sweep-*` suites), not across unrelated scenes.
+fn scaling_family(report: &Report) -> Option<(String, Vec<u64>)> {
+    let mut best: Option<(String, Vec<u64>)> = None;
+    for name in scene_names(report) {
+        let fam = family(&name);
+        let mut sizes: Vec<u64> = report
+            .results
+            .iter()
+            .filter(|r| family(&r.scene) == fam)
+            .map(|r| r.triangles.traced)
+            .collect();
+        sizes.sort_unstable();
+        sizes.dedup();
+        if sizes.len() >= 3 && best.as_ref().is_none_or(|b| sizes.len() > b.1.len()) {
+            best = Some((fam.to_string(), sizes));
+        }
     }
+    best
+}
+
+fn scaling_chart(report: &Report) -> Result<Option<String>> {
+    let Some((fam, sizes)) = scaling_family(report) else {
+        return Ok(None);
+    };
     let wl = timing_workload(report);
     let mut build = Vec::new();
     let mut trace = Vec::new();
     for st in structure_names(report) {
         let mut b = Vec::new();
         let mut t = Vec::new();
-        for r in report.results.iter().filter(|r| r.structure == st) {
+        for r in report
+            .results
+            .iter()
+            .filter(|r| r.structure == st && family(&r.scene) == fam)
+        {
             let n = r.triangles.traced as f64;
             b.push((n, r.build.median_ms));
             if let Some(w) = r
@@ -388,7 +415,7 @@ fn scaling_chart(report: &Report) -> Result<Option<String>> {
     );
     let panels = [
         LogLog {
-            title: "Build time against triangles".into(),
+            title: format!("{fam}: build time against triangles"),
             x_desc: "triangles".into(),
             y_desc: "build ms".into(),
             series: build,
