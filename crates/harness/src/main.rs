@@ -141,6 +141,9 @@ struct RunArgs {
     /// Output directory (default: reports/<date>-<revision>).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Leave the per-pixel pictures of primary rays out of the report (smaller; for baselines).
+    #[arg(long)]
+    no_images: bool,
 }
 
 fn main() -> ExitCode {
@@ -364,6 +367,7 @@ fn run_command(args: RunArgs) -> Result<ExitCode> {
         trace_runs: args.trace_runs,
         ftz_daz: args.ftz_daz,
         progress: std::io::stdout().is_terminal(),
+        images: !args.no_images,
     };
     let report = run(&opts, &requests)?;
     let dir = args.out.unwrap_or_else(default_out_dir);

@@ -32,6 +32,9 @@ pub struct RunOptions {
     pub trace_runs: usize,
     pub ftz_daz: bool,
     pub progress: bool,
+    /// Keep per-pixel pictures of the primary workload in the report (see `images`); off for
+    /// baselines, which are compared, not looked at.
+    pub images: bool,
 }
 
 /// A scene to load: by spec, or a suite file entry (with its `optional` flag).
@@ -414,7 +417,7 @@ impl<'a> SceneRun<'a> {
                 validate(&s.mesh, &wl.rays, &answers, &wl.reference, &sides, tol);
             validation.counted_path_differs = count_differences(&answers, &counted);
             let has_counters = accel.has_counters();
-            if let (Some((w, h)), Answers::Closest(hits)) = (wl.size, &answers) {
+            if let (true, Some((w, h)), Answers::Closest(hits)) = (opts.images, wl.size, &answers) {
                 let pixels: Vec<PixelInput> = (0..wl.rays.len())
                     .map(|i| PixelInput {
                         cost: has_counters.then_some(work[i]),

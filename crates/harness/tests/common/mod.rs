@@ -20,5 +20,6 @@ pub fn options(structures: &[&str]) -> RunOptions {
         trace_runs: 1,
         ftz_daz: false,
         progress: false,
+        images: true,
     }
 }
