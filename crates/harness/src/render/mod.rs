@@ -79,10 +79,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
 }
 
-/// A file-name-safe form of a scene or structure name.
+/// A file-name-safe form of a name: lower-case letters and digits, everything else `-`
+/// (`teapot.obj` → `teapot-obj`, so it never meets the generator `teapot`).
 pub fn slug(name: &str) -> String {
     let s: String = name
-        .trim_end_matches(".obj")
         .chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() {
@@ -94,6 +94,25 @@ pub fn slug(name: &str) -> String {
         .collect();
     let s = s.trim_matches('-').to_string();
     if s.is_empty() { "unnamed".into() } else { s }
+}
+
+/// File-name slugs for the report's scenes, made unique with a `-2`, `-3`… suffix when two
+/// names map to the same slug (`a:b` and `a-b`).
+pub(crate) fn scene_slugs(report: &Report) -> std::collections::HashMap<String, String> {
+    let mut used = std::collections::HashSet::new();
+    scene_names(report)
+        .into_iter()
+        .map(|name| {
+            let base = slug(&name);
+            let mut candidate = base.clone();
+            let mut k = 2;
+            while !used.insert(candidate.clone()) {
+                candidate = format!("{base}-{k}");
+                k += 1;
+            }
+            (name, candidate)
+        })
+        .collect()
 }
 
 pub(crate) fn scene_names(report: &Report) -> Vec<String> {
@@ -285,10 +304,11 @@ pub fn all_charts(report: &Report) -> Result<Vec<(String, String, String)>> {
             svg,
         ));
     }
+    let slugs = scene_slugs(report);
     for scene in scene_names(report) {
         if let Some(svg) = break_even_chart(report, &scene)? {
             out.push((
-                format!("break-even-{}.svg", slug(&scene)),
+                format!("break-even-{}.svg", slugs[&scene]),
                 format!("{scene}: total time to build once and trace K rays"),
                 svg,
             ));
@@ -525,6 +545,7 @@ fn write_pictures(
     pictures::write_legend(&legend)?;
     written.push(legend);
     let mut out = Vec::new();
+    let slugs = scene_slugs(report);
     for scene in scene_names(report) {
         let entries: Vec<&ResultEntry> = report
             .results
@@ -542,7 +563,7 @@ fn write_pictures(
         let mut rows = Vec::new();
         for r in &entries {
             let img = r.primary_image.as_ref().expect("filtered");
-            let base = format!("{}--{}", slug(&scene), slug(&r.structure));
+            let base = format!("{}--{}", slugs[&scene], slug(&r.structure));
             let file = |kind: &str| format!("images/{base}-{kind}.png");
             let heat = match pictures::heatmap_pixels(img, max)? {
                 Some(px) => {
@@ -569,4 +590,17 @@ fn write_pictures(
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::slug;
+
+    #[test]
+    fn slugs_keep_files_and_generators_apart() {
+        assert_eq!(slug("teapot.obj"), "teapot-obj");
+        assert_ne!(slug("teapot.obj"), slug("teapot"));
+        assert_eq!(slug("sphere:triangles=2000"), "sphere-triangles-2000");
+        assert_eq!(slug("::"), "unnamed");
+    }
 }
