@@ -1,61 +1,26 @@
-//! Criterion benches: building on the bunny and tracing 100k random rays through it, per
-//! builder. Falls back to a generated teapot of the bunny's size when ../shared/scenes is absent
-//! (and says so). `cargo bench -p raybench-bvh`.
+//! Criterion benches (the testkit's shared pair): building on the bunny and tracing 100k random
+//! rays through it, per builder. `cargo bench -p raybench-bvh`.
 
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use raybench_accel::Accel;
-use raybench_bvh::{Bvh, BvhParams};
-use raybench_scenes::Scene;
-use std::hint::black_box;
-use std::sync::Arc;
+use criterion::{Criterion, criterion_group, criterion_main};
+use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
+use raybench_testkit::bench::build_and_trace;
 
-fn bunny() -> Scene {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/scenes/stanford-bunny.obj"
-    );
-    raybench_scenes::load_obj(std::path::Path::new(path)).unwrap_or_else(|e| {
-        eprintln!("bench: the bunny is not available ({e}); using teapot:triangles=69451");
-        raybench_scenes::generate("teapot:triangles=69451", 1).expect("teapot generates")
-    })
+fn named(params: Vec<BvhParams>) -> Vec<(String, BvhParams)> {
+    params.into_iter().map(|p| (p.name(), p)).collect()
 }
 
-fn variants() -> [BvhParams; 3] {
-    [BvhParams::median(), BvhParams::sweep(), BvhParams::binned()]
+fn benches(c: &mut Criterion) {
+    let builders = named(vec![
+        BvhParams::median(),
+        BvhParams::sweep(),
+        BvhParams::binned(),
+    ]);
+    let mut traversals = builders.clone();
+    traversals.extend(named(vec![BvhParams::binned_unordered()]));
+    build_and_trace::<Bvh>(c, "bvh", &builders, &traversals);
+    let wide = vec![("bvh8-binned".to_string(), Bvh8Params::default())];
+    build_and_trace::<Bvh8>(c, "bvh8", &wide, &wide);
 }
 
-fn build(c: &mut Criterion) {
-    let scene = bunny();
-    let mut group = c.benchmark_group("bvh-build-bunny");
-    group.sample_size(10);
-    group.throughput(Throughput::Elements(scene.mesh.len() as u64));
-    for params in variants() {
-        group.bench_with_input(
-            BenchmarkId::from_parameter(params.name()),
-            &params,
-            |b, p| b.iter(|| black_box(Bvh::build(Arc::clone(&scene.mesh), p).expect("builds"))),
-        );
-    }
-    group.finish();
-}
-
-fn trace(c: &mut Criterion) {
-    let scene = bunny();
-    let rays = raybench_scenes::random_rays(&scene.mesh.bounds(), 100_000, 1);
-    let mut group = c.benchmark_group("bvh-random-100k-bunny");
-    group.sample_size(10);
-    group.throughput(Throughput::Elements(rays.len() as u64));
-    for params in variants()
-        .into_iter()
-        .chain([BvhParams::binned_unordered()])
-    {
-        let bvh = Bvh::build(Arc::clone(&scene.mesh), &params).expect("builds");
-        group.bench_function(params.name(), |b| {
-            b.iter(|| rays.iter().filter(|r| bvh.intersect(r).is_some()).count())
-        });
-    }
-    group.finish();
-}
-
-criterion_group!(benches, build, trace);
-criterion_main!(benches);
+criterion_group!(group, benches);
+criterion_main!(group);

@@ -3,9 +3,9 @@
 //! planes, edges and corners.
 
 use raybench_accel::{Accel, BuildError};
-use raybench_geom::{Ray, Triangle, TriangleMesh, Vec3};
+use raybench_geom::{Ray, TriangleMesh, Vec3};
 use raybench_grid::{Grid, GridParams};
-use raybench_testkit::{Case, check_case, conformance, lattice_rays, seeded_rng};
+use raybench_testkit::{Case, check_case, conformance, lattice_rays, lattice_scene};
 use std::sync::Arc;
 
 fn check(params: GridParams) {
@@ -84,53 +84,9 @@ fn too_large_is_an_error_not_an_abort() {
     ));
 }
 
-/// A scene whose bounds are exactly [0, 4]³ and whose grid is 8³ cells of side 0.5 (dyadic
-/// planes), with triangles lying exactly on cell planes (G11), a random soup, and a big
-/// slanted triangle (hits beyond the current cell, B11).
+/// The testkit's lattice scene with a grid of 8³ cells of side 0.5 (dyadic planes).
 fn plane_scene() -> (Arc<TriangleMesh>, GridParams) {
-    let mut tris = vec![
-        // Pins for the bounds.
-        Triangle::new(
-            Vec3::ZERO,
-            Vec3::new(0.1, 0.0, 0.0),
-            Vec3::new(0.0, 0.1, 0.0),
-        ),
-        Triangle::new(
-            Vec3::splat(4.0),
-            Vec3::new(3.9, 4.0, 4.0),
-            Vec3::new(4.0, 3.9, 4.0),
-        ),
-        // On planes z = 2, x = 1.5 and y = 3 (cell planes), spanning several cells.
-        Triangle::new(
-            Vec3::new(0.5, 0.5, 2.0),
-            Vec3::new(3.5, 0.5, 2.0),
-            Vec3::new(0.5, 3.5, 2.0),
-        ),
-        Triangle::new(
-            Vec3::new(1.5, 0.5, 0.5),
-            Vec3::new(1.5, 3.0, 0.5),
-            Vec3::new(1.5, 0.5, 3.0),
-        ),
-        Triangle::new(
-            Vec3::new(2.5, 3.0, 0.5),
-            Vec3::new(3.5, 3.0, 0.5),
-            Vec3::new(2.5, 3.0, 3.5),
-        ),
-        // A big slanted triangle.
-        Triangle::new(
-            Vec3::new(0.2, 0.3, 3.9),
-            Vec3::new(3.9, 0.2, 0.1),
-            Vec3::new(2.0, 3.9, 2.0),
-        ),
-    ];
-    let mut rng = seeded_rng(0x5eed_6001);
-    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
-    for _ in 0..400 {
-        let c = Vec3::new(f(), f(), f()) * 3.6 + 0.2;
-        let mut v = || c + (Vec3::new(f(), f(), f()) - 0.5) * 0.3;
-        tris.push(Triangle::new(v(), v(), v()));
-    }
-    let mesh = Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0);
+    let mesh = lattice_scene();
     // λN = 512 cells over a 4³ box: side 0.5, 8 per axis.
     let params = GridParams::with_density(512.0 / mesh.len() as f64);
     (mesh, params)

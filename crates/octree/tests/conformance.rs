@@ -3,10 +3,9 @@
 //! planes, octant edges and corners.
 
 use raybench_accel::{Accel, BuildError, Counters};
-use raybench_geom::{Ray, Triangle, TriangleMesh, Vec3};
+use raybench_geom::{Ray, Vec3};
 use raybench_octree::{Octree, OctreeParams};
-use raybench_testkit::{Case, check_case, conformance, lattice_rays, seeded_rng};
-use std::sync::Arc;
+use raybench_testkit::{Case, check_case, conformance, lattice_rays, lattice_scene};
 
 fn check(params: OctreeParams) {
     let counts = conformance::<Octree>(&params, &|t, mesh| t.validate(mesh));
@@ -95,55 +94,9 @@ fn degenerate_inputs_stop_early() {
     }
 }
 
-/// A scene whose bounds are exactly [0, 4]³, so the root is that cube and every split plane is
-/// a multiple of a power of two: triangles lie exactly on split planes (G11), plus a random
-/// soup and a big slanted triangle (hits beyond the current leaf, B11).
-fn plane_scene() -> Arc<TriangleMesh> {
-    let mut tris = vec![
-        Triangle::new(
-            Vec3::ZERO,
-            Vec3::new(0.1, 0.0, 0.0),
-            Vec3::new(0.0, 0.1, 0.0),
-        ),
-        Triangle::new(
-            Vec3::splat(4.0),
-            Vec3::new(3.9, 4.0, 4.0),
-            Vec3::new(4.0, 3.9, 4.0),
-        ),
-        Triangle::new(
-            Vec3::new(0.5, 0.5, 2.0),
-            Vec3::new(3.5, 0.5, 2.0),
-            Vec3::new(0.5, 3.5, 2.0),
-        ),
-        Triangle::new(
-            Vec3::new(1.0, 0.5, 0.5),
-            Vec3::new(1.0, 3.0, 0.5),
-            Vec3::new(1.0, 0.5, 3.0),
-        ),
-        Triangle::new(
-            Vec3::new(2.5, 3.0, 0.5),
-            Vec3::new(3.5, 3.0, 0.5),
-            Vec3::new(2.5, 3.0, 3.5),
-        ),
-        Triangle::new(
-            Vec3::new(0.2, 0.3, 3.9),
-            Vec3::new(3.9, 0.2, 0.1),
-            Vec3::new(2.0, 3.9, 2.0),
-        ),
-    ];
-    let mut rng = seeded_rng(0x5eed_6001);
-    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
-    for _ in 0..400 {
-        let c = Vec3::new(f(), f(), f()) * 3.6 + 0.2;
-        let mut v = || c + (Vec3::new(f(), f(), f()) - 0.5) * 0.3;
-        tris.push(Triangle::new(v(), v(), v()));
-    }
-    Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0)
-}
-
 #[test]
 fn rays_along_split_planes_edges_and_corners() {
-    let mesh = plane_scene();
+    let mesh = lattice_scene();
     for params in [
         OctreeParams::default(),
         OctreeParams {
@@ -174,7 +127,7 @@ fn rays_along_split_planes_edges_and_corners() {
 
 #[test]
 fn walks_are_bounded_and_counted() {
-    let mesh = plane_scene();
+    let mesh = lattice_scene();
     let tree = Octree::build(mesh, &OctreeParams::default()).unwrap();
     let mut total = Counters::default();
     for r in lattice_rays() {

@@ -319,3 +319,50 @@ pub fn edge_cases() -> Vec<Case> {
 
     cases
 }
+
+/// The scene [`crate::lattice_rays`] is made for: bounds exactly [0, 4]³, so grid cells of side
+/// 0.5 and octree or k-d split planes at dyadic positions fall on multiples of 0.5; triangles
+/// lying exactly on such planes (z = 2, x = 1, y = 3: bug class G11), a seeded soup, and a big
+/// slanted triangle whose hits lie beyond the current cell (B11).
+pub fn lattice_scene() -> Arc<TriangleMesh> {
+    let mut tris = vec![
+        Triangle::new(
+            Vec3::ZERO,
+            Vec3::new(0.1, 0.0, 0.0),
+            Vec3::new(0.0, 0.1, 0.0),
+        ),
+        Triangle::new(
+            Vec3::splat(4.0),
+            Vec3::new(3.9, 4.0, 4.0),
+            Vec3::new(4.0, 3.9, 4.0),
+        ),
+        Triangle::new(
+            Vec3::new(0.5, 0.5, 2.0),
+            Vec3::new(3.5, 0.5, 2.0),
+            Vec3::new(0.5, 3.5, 2.0),
+        ),
+        Triangle::new(
+            Vec3::new(1.0, 0.5, 0.5),
+            Vec3::new(1.0, 3.0, 0.5),
+            Vec3::new(1.0, 0.5, 3.0),
+        ),
+        Triangle::new(
+            Vec3::new(2.5, 3.0, 0.5),
+            Vec3::new(3.5, 3.0, 0.5),
+            Vec3::new(2.5, 3.0, 3.5),
+        ),
+        Triangle::new(
+            Vec3::new(0.2, 0.3, 3.9),
+            Vec3::new(3.9, 0.2, 0.1),
+            Vec3::new(2.0, 3.9, 2.0),
+        ),
+    ];
+    let mut rng = seeded_rng(0x5eed_6001);
+    let mut f = move || (rng.next_u32() >> 8) as f32 / (1u32 << 24) as f32;
+    for _ in 0..400 {
+        let c = Vec3::new(f(), f(), f()) * 3.6 + 0.2;
+        let mut v = || c + (Vec3::new(f(), f(), f()) - 0.5) * 0.3;
+        tris.push(Triangle::new(v(), v(), v()));
+    }
+    Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0)
+}

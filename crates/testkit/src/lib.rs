@@ -16,10 +16,11 @@
 //! the case, the seed and the exact ray bits.
 #![forbid(unsafe_code)]
 
+pub mod bench;
 mod cases;
 mod rays;
 
-pub use cases::{Case, edge_cases, seeded_cases};
+pub use cases::{Case, edge_cases, lattice_scene, seeded_cases};
 pub use rays::{centroid_rays, lattice_rays, random_rays_in, seeded_rng};
 
 use raybench_accel::compare::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
