@@ -4,6 +4,7 @@
 
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 
 /// A categorical palette (Tableau 10), cycled.
@@ -120,82 +121,73 @@ fn draw_bars<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &Bars) -> Res
             String::new()
         }
     };
-    let mut builder = ChartBuilder::on(area);
-    builder
+    let x_range = -0.5..(n as f64 - 0.5);
+    if c.log_y {
+        // Headroom above the tallest bar for the legend box; bars rise from below the lowest.
+        let top = hi * 2.0 * (hi / lo * 4.0).max(4.0).powf(0.35);
+        bars_on(
+            area,
+            c,
+            x_range,
+            ((lo / 2.0)..top).log_scale(),
+            lo / 2.0,
+            &x_fmt,
+        )
+    } else {
+        bars_on(area, c, x_range, 0.0..(hi * 1.45).max(1e-9), 0.0, &x_fmt)
+    }
+}
+
+/// Draws `c` with a linear or logarithmic y axis (`y_range`); bars start at `base`.
+fn bars_on<DB, Y>(
+    area: &DrawingArea<DB, Shift>,
+    c: &Bars,
+    x_range: std::ops::Range<f64>,
+    y_range: Y,
+    base: f64,
+    x_fmt: &dyn Fn(&f64) -> String,
+) -> Result<()>
+where
+    DB: DrawingBackend,
+    Y: AsRangedCoord<Value = f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let n = c.groups.len().max(1);
+    let mut chart = ChartBuilder::on(area)
         .caption(&c.title, ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(40)
-        .y_label_area_size(80);
-    let x_range = -0.5..(n as f64 - 0.5);
+        .y_label_area_size(80)
+        .build_cartesian_2d(x_range, y_range)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(n + 1)
+        .x_label_formatter(x_fmt)
+        .x_label_style(("sans-serif", 11))
+        .y_desc(c.y_desc.as_str())
+        .y_label_formatter(&|y| format_value(*y))
+        .draw()
+        .map_err(plot_err)?;
     let width = 0.8 / c.series.len().max(1) as f64;
-    let legend_pos = SeriesLabelPosition::UpperRight;
-    if c.log_y {
-        // Headroom above the tallest bar for the legend box.
-        let y_range = (lo / 2.0)..(hi * 2.0 * (hi / lo * 4.0).max(4.0).powf(0.35));
-        let mut chart = builder
-            .build_cartesian_2d(x_range, y_range.log_scale())
-            .map_err(plot_err)?;
+    for (s, series) in c.series.iter().enumerate() {
+        let col = color(s);
+        let rects = bar_rects(series, s, width, base);
         chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(n + 1)
-            .x_label_formatter(&x_fmt)
-            .x_label_style(("sans-serif", 11))
-            .y_desc(c.y_desc.as_str())
-            .y_label_formatter(&|y| format_value(*y))
-            .draw()
-            .map_err(plot_err)?;
-        let base = lo / 2.0;
-        for (s, series) in c.series.iter().enumerate() {
-            let col = color(s);
-            let rects = bar_rects(series, s, width, base);
-            chart
-                .draw_series(rects.into_iter().map(|r| Rectangle::new(r, col.filled())))
-                .map_err(plot_err)?
-                .label(series.name.as_str())
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], col.filled()));
-        }
-        chart
-            .configure_series_labels()
-            .position(legend_pos)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 11))
-            .draw()
-            .map_err(plot_err)?;
-    } else {
-        let y_range = 0.0..(hi * 1.45).max(1e-9);
-        let mut chart = builder
-            .build_cartesian_2d(x_range, y_range)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(n + 1)
-            .x_label_formatter(&x_fmt)
-            .x_label_style(("sans-serif", 11))
-            .y_desc(c.y_desc.as_str())
-            .y_label_formatter(&|y| format_value(*y))
-            .draw()
-            .map_err(plot_err)?;
-        for (s, series) in c.series.iter().enumerate() {
-            let col = color(s);
-            let rects = bar_rects(series, s, width, 0.0);
-            chart
-                .draw_series(rects.into_iter().map(|r| Rectangle::new(r, col.filled())))
-                .map_err(plot_err)?
-                .label(series.name.as_str())
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], col.filled()));
-        }
-        chart
-            .configure_series_labels()
-            .position(legend_pos)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 11))
-            .draw()
-            .map_err(plot_err)?;
+            .draw_series(rects.into_iter().map(|r| Rectangle::new(r, col.filled())))
+            .map_err(plot_err)?
+            .label(series.name.as_str())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], col.filled()));
     }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 11))
+        .draw()
+        .map_err(plot_err)?;
     Ok(())
 }
 
