@@ -3,7 +3,7 @@
 use crate::simd::F4;
 use crate::{Bvh, ChildRef, MAX_DEPTH, Node};
 use raybench_accel::{CounterSink, Hit};
-use raybench_geom::{Ray, TriHit, max_keep, min_keep};
+use raybench_geom::{MollerTriangle, Ray, TriHit, max_keep, min_keep};
 
 /// What the slab test needs of a ray, with each axis's near/far plane choice made once.
 struct SlabRay {
@@ -101,18 +101,15 @@ impl Bvh {
             // Descend: interior nodes until both children are missed or a leaf is reached.
             while let Some(r) = next.take() {
                 if r.is_leaf() {
-                    c.leaf();
-                    let first = r.index as usize;
-                    let leaf = &self.triangles[first..first + r.count as usize];
-                    for (k, tri) in leaf.iter().enumerate() {
-                        c.prim_tests(1);
-                        if let Some(h) = tri.intersect(&ray.with_t_max(best_t)) {
-                            best_t = h.t;
-                            best = Some((first + k, h));
-                            if ANY_HIT {
-                                break 'walk;
-                            }
-                        }
+                    if intersect_leaf::<ANY_HIT, C>(
+                        &self.triangles,
+                        r,
+                        ray,
+                        &mut best_t,
+                        &mut best,
+                        c,
+                    ) {
+                        break 'walk;
                     }
                     break;
                 }
@@ -156,4 +153,34 @@ impl Bvh {
             v: h.v,
         })
     }
+}
+
+/// Tests the triangles of leaf `r` against `ray` below `*best_t`, keeping the closest hit
+/// (as an index into `triangles`); true when an any-hit query may stop. Shared by the binary
+/// and the wide traversal.
+#[inline(always)]
+pub(crate) fn intersect_leaf<const ANY_HIT: bool, C: CounterSink>(
+    triangles: &[MollerTriangle],
+    r: ChildRef,
+    ray: &Ray,
+    best_t: &mut f32,
+    best: &mut Option<(usize, TriHit)>,
+    c: &mut C,
+) -> bool {
+    c.leaf();
+    let first = r.index as usize;
+    for (k, tri) in triangles[first..first + r.count as usize]
+        .iter()
+        .enumerate()
+    {
+        c.prim_tests(1);
+        if let Some(h) = tri.intersect(&ray.with_t_max(*best_t)) {
+            *best_t = h.t;
+            *best = Some((first + k, h));
+            if ANY_HIT {
+                return true;
+            }
+        }
+    }
+    false
 }

@@ -15,6 +15,7 @@ use crate::BvhParams;
 use crate::build;
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::simd::F4;
+use crate::traverse::intersect_leaf;
 use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, NoCount, PreparedRays,
     SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST,
@@ -338,20 +339,15 @@ impl Bvh8 {
         'walk: loop {
             while let Some(r) = next.take() {
                 if r.is_leaf() {
-                    c.leaf();
-                    let first = r.index as usize;
-                    for (k, tri) in self.triangles[first..first + r.count as usize]
-                        .iter()
-                        .enumerate()
-                    {
-                        c.prim_tests(1);
-                        if let Some(h) = tri.intersect(&ray.with_t_max(best_t)) {
-                            best_t = h.t;
-                            best = Some((first + k, h));
-                            if ANY_HIT {
-                                break 'walk;
-                            }
-                        }
+                    if intersect_leaf::<ANY_HIT, C>(
+                        &self.triangles,
+                        r,
+                        ray,
+                        &mut best_t,
+                        &mut best,
+                        c,
+                    ) {
+                        break 'walk;
                     }
                     break;
                 }
