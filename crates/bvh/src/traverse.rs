@@ -3,12 +3,10 @@
 use crate::simd::F4;
 use crate::{Bvh, ChildRef, MAX_DEPTH, Node};
 use raybench_accel::{CounterSink, Hit};
-use raybench_geom::{MollerTriangle, Ray, TriHit, max_keep, min_keep};
+use raybench_geom::{MollerTriangle, Ray, TriHit};
 
 /// What the slab test needs of a ray, with each axis's near/far plane choice made once.
 struct SlabRay {
-    origin: [f32; 3],
-    inv_dir: [f32; 3],
     /// Per axis, 1 when the direction's sign bit is set (so -0, whose inverse is -inf, counts
     /// as negative: bug class B3): the index of the near plane in a box `[min, max]`, and
     /// `1 - near` the far one.
@@ -25,31 +23,13 @@ impl SlabRay {
         let inv = ray.inv_dir().to_array();
         let origin = ray.origin().to_array();
         SlabRay {
-            origin,
-            inv_dir: inv,
             near: inv.map(|x| x.is_sign_negative() as usize),
             origin4: origin.map(F4::splat),
             inv4: inv.map(|x| F4::new(x, x, -x, -x)),
         }
     }
 
-    /// Entry distance into the box `[min, max]` within `[t_min, t_max]`, or `None`. The only
-    /// possible NaN (`0 * inf`, origin on a face plane with a zero direction component) is
-    /// ignored by `max_keep`/`min_keep`, which is the right answer for a closed box (B1).
-    #[inline(always)]
-    fn enter(&self, b: &[[f32; 3]; 2], t_min: f32, t_max: f32) -> Option<f32> {
-        let (mut t0, mut t1) = (t_min, t_max);
-        for a in 0..3 {
-            t0 = max_keep(t0, (b[self.near[a]][a] - self.origin[a]) * self.inv_dir[a]);
-            t1 = min_keep(
-                t1,
-                (b[1 - self.near[a]][a] - self.origin[a]) * self.inv_dir[a],
-            );
-        }
-        (t0 <= t1).then_some(t0)
-    }
-
-    /// Both children of `n` at once, the same arithmetic as [`SlabRay::enter`] lane for lane:
+    /// Both children of `n` at once, the same arithmetic as `Aabb::intersect` lane for lane:
     /// lanes `[entry 0, entry 1, -exit 0, -exit 1]` start at `[t_min, t_min, -t_max, -t_max]`
     /// and each axis raises them with its near (or negated far) plane distances; a NaN lane is
     /// ignored because `max_keep` keeps the accumulator. Returns a mask (bit `i`: child `i` is
@@ -89,11 +69,7 @@ impl Bvh {
         let t_min = ray.t_min();
         let mut best_t = ray.t_max();
         let mut best: Option<(usize, TriHit)> = None;
-        let root = [
-            self.root_bounds.min.to_array(),
-            self.root_bounds.max.to_array(),
-        ];
-        slab.enter(&root, t_min, best_t)?;
+        self.root_bounds.intersect(ray)?;
         let mut stack = [(ChildRef::default(), 0f32); MAX_DEPTH];
         let mut sp = 0;
         let mut next = Some(self.root);

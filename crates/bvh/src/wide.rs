@@ -20,7 +20,7 @@ use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, NoCount, PreparedRays,
     SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST,
 };
-use raybench_geom::{Aabb, MollerTriangle, Ray, TriHit, TriangleMesh, Vec3, max_keep, min_keep};
+use raybench_geom::{Aabb, MollerTriangle, Ray, TriHit, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -295,21 +295,6 @@ impl WideRay {
     }
 }
 
-fn scalar_enter(ray: &Ray, b: &Aabb, t_min: f32, t_max: f32) -> Option<f32> {
-    let (o, inv) = (ray.origin(), ray.inv_dir());
-    let (mut t0, mut t1) = (t_min, t_max);
-    for a in 0..3 {
-        let (lo, hi) = if inv[a].is_sign_negative() {
-            (b.max[a], b.min[a])
-        } else {
-            (b.min[a], b.max[a])
-        };
-        t0 = max_keep(t0, (lo - o[a]) * inv[a]);
-        t1 = min_keep(t1, (hi - o[a]) * inv[a]);
-    }
-    (t0 <= t1).then_some(t0)
-}
-
 type Entry = (ChildRef, f32);
 
 thread_local! {
@@ -331,7 +316,7 @@ impl Bvh8 {
         }
         let t_min = ray.t_min();
         let mut best_t = ray.t_max();
-        scalar_enter(ray, &self.root_bounds, t_min, best_t)?;
+        self.root_bounds.intersect(ray)?;
         let wide = WideRay::new(ray);
         let mut best: Option<(usize, TriHit)> = None;
         stack.clear();

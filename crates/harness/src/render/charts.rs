@@ -62,18 +62,26 @@ fn plot_err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
 
 /// Renders one chart to an SVG string.
 pub fn bars_svg(chart: &Bars, width: u32, height: u32) -> Result<String> {
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_err)?;
-        draw_bars(&root, chart)?;
-        root.present().map_err(plot_err)?;
-    }
-    Ok(svg)
+    panels_svg(std::slice::from_ref(chart), width, height, |a, c| {
+        draw_bars(a, c)
+    })
 }
 
 /// Several charts stacked vertically in one SVG (e.g. the three counters of a workload).
+#[allow(clippy::redundant_closure)]
 pub fn stacked_bars_svg(charts: &[Bars], width: u32, panel_height: u32) -> Result<String> {
+    panels_svg(charts, width, panel_height, |a, c| draw_bars(a, c))
+}
+
+/// One SVG of `panel_height`-high panels stacked vertically, each drawn by `draw`. Callers pass
+/// closures, not the generic draw functions themselves: those are instantiated for one
+/// backend lifetime, and `draw` must accept any (clippy's `redundant_closure` is wrong here).
+fn panels_svg<T>(
+    charts: &[T],
+    width: u32,
+    panel_height: u32,
+    draw: impl Fn(&DrawingArea<SVGBackend, Shift>, &T) -> Result<()>,
+) -> Result<String> {
     let mut svg = String::new();
     {
         let height = panel_height * charts.len().max(1) as u32;
@@ -81,7 +89,7 @@ pub fn stacked_bars_svg(charts: &[Bars], width: u32, panel_height: u32) -> Resul
         root.fill(&WHITE).map_err(plot_err)?;
         let panels = root.split_evenly((charts.len().max(1), 1));
         for (panel, chart) in panels.iter().zip(charts) {
-            draw_bars(panel, chart)?;
+            draw(panel, chart)?;
         }
         root.present().map_err(plot_err)?;
     }
@@ -254,19 +262,9 @@ fn ok(v: f64) -> bool {
     v.is_finite() && v > 0.0
 }
 
+#[allow(clippy::redundant_closure)]
 pub fn loglog_svg(charts: &[LogLog], width: u32, panel_height: u32) -> Result<String> {
-    let mut svg = String::new();
-    {
-        let height = panel_height * charts.len().max(1) as u32;
-        let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_err)?;
-        let panels = root.split_evenly((charts.len().max(1), 1));
-        for (panel, chart) in panels.iter().zip(charts) {
-            draw_loglog(panel, chart)?;
-        }
-        root.present().map_err(plot_err)?;
-    }
-    Ok(svg)
+    panels_svg(charts, width, panel_height, |a, c| draw_loglog(a, c))
 }
 
 fn draw_loglog<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &LogLog) -> Result<()> {
