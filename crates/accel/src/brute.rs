@@ -1,9 +1,12 @@
-//! BruteForce: tests every triangle against every ray. O(N) per ray, no build, no cleverness —
-//! which is the point: it is the oracle the other structures are checked against. Ties (equal
-//! t) resolve to the lowest primitive index.
+//! BruteForce: tests every triangle against every ray (and every query point). O(N) per query,
+//! no build, no cleverness — which is the point: it is the oracle the other structures are
+//! checked against. Ties (equal t, or equal distance for closest-point queries) resolve to the
+//! lowest primitive index.
 
-use crate::{Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, NoCount};
-use raybench_geom::{MollerTriangle, Ray, TriHit, Triangle, TriangleMesh, TriangleTest};
+use crate::{
+    Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, Nearest, NoCount, PointHit,
+};
+use raybench_geom::{MollerTriangle, Ray, TriHit, Triangle, TriangleMesh, TriangleTest, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -16,6 +19,9 @@ pub struct BruteForceParams {
 pub struct BruteForce {
     name: String,
     triangles: Triangles,
+    /// The original vertices, for closest-point queries: `MollerTriangle` keeps edges, and
+    /// `v0 - e1` does not always give back `v1` exactly.
+    mesh: Arc<TriangleMesh>,
 }
 
 /// Triangles in the layout their test wants: Möller–Trumbore reads Embree's precomputed
@@ -68,6 +74,23 @@ fn scan<const ANY_HIT: bool, T, C: CounterSink>(
     best
 }
 
+/// The closest-point scan: every triangle's exact closest point, keeping the nearest within
+/// the radius (the lowest index on equal distance, [`Nearest`]'s rule). One `prim_tests` per
+/// point–triangle distance.
+fn closest_point_scan<C: CounterSink>(
+    mesh: &TriangleMesh,
+    p: Vec3,
+    max_radius: f32,
+    c: &mut C,
+) -> Option<PointHit> {
+    let mut nearest = Nearest::within(p, max_radius)?;
+    for (prim, tri) in mesh.triangles().enumerate() {
+        c.prim_tests(1);
+        nearest.test_triangle(p, prim as u32, &tri);
+    }
+    nearest.into_hit()
+}
+
 impl BruteForce {
     fn len(&self) -> usize {
         match &self.triangles {
@@ -94,6 +117,7 @@ impl Accel for BruteForce {
         Ok(BruteForce {
             name: name.to_string(),
             triangles,
+            mesh,
         })
     }
 
@@ -115,6 +139,19 @@ impl Accel for BruteForce {
 
     fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
         self.trace::<true, _>(ray, c).is_some()
+    }
+
+    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
+        closest_point_scan(&self.mesh, p, max_radius, &mut NoCount)
+    }
+
+    fn closest_point_counted(
+        &self,
+        p: Vec3,
+        max_radius: f32,
+        c: &mut Counters,
+    ) -> Option<PointHit> {
+        closest_point_scan(&self.mesh, p, max_radius, c)
     }
 
     fn build_stats(&self) -> BuildStats {
@@ -185,6 +222,77 @@ mod tests {
         let r = Ray::infinite(Vec3::ZERO, Vec3::X);
         assert_eq!(bf.intersect(&r), None);
         assert!(!bf.occluded(&r));
+    }
+
+    #[test]
+    fn closest_point_is_nearest_with_lowest_prim_on_ties() {
+        let bf = BruteForce::build(two_layers(), &Default::default()).unwrap();
+        let p = Vec3::new(0.2, 0.2, 1.0);
+        let h = bf.closest_point(p, f32::INFINITY).unwrap();
+        assert_eq!((h.prim, h.distance), (1, 1.0));
+        // Face region: the barycentric weights are rounded, the point is not exactly (0.2, 0.2).
+        assert!(
+            h.point.distance(Vec3::new(0.2, 0.2, 0.0)) < 1e-6,
+            "{}",
+            h.point
+        );
+        let mut c = Counters::default();
+        assert_eq!(bf.closest_point_counted(p, f32::INFINITY, &mut c), Some(h));
+        assert_eq!(c.prim_tests, 3, "one distance test per triangle");
+        // Below both layers: the z = -1 triangle (prim 0) is nearer.
+        let below = bf.closest_point(Vec3::new(0.2, 0.2, -1.5), f32::INFINITY);
+        assert_eq!(below.map(|h| (h.prim, h.distance)), Some((0, 0.5)));
+    }
+
+    #[test]
+    fn closest_point_radius_is_inclusive() {
+        let bf = BruteForce::build(two_layers(), &Default::default()).unwrap();
+        let p = Vec3::new(0.2, 0.2, 1.0);
+        assert_eq!(bf.closest_point(p, 1.0).map(|h| h.prim), Some(1));
+        assert_eq!(bf.closest_point(p, 0.999), None);
+        let on_surface = Vec3::new(0.0, 0.0, 0.0);
+        assert_eq!(bf.closest_point(on_surface, 0.0).map(|h| h.prim), Some(1));
+    }
+
+    #[test]
+    fn closest_point_rejects_bad_queries_without_panicking() {
+        let bf = BruteForce::build(two_layers(), &Default::default()).unwrap();
+        let mut c = Counters::default();
+        for (p, r) in [
+            (Vec3::new(f32::NAN, 0.0, 0.0), f32::INFINITY),
+            (Vec3::new(0.0, f32::INFINITY, 0.0), f32::INFINITY),
+            (Vec3::new(0.0, 0.0, 1e19), f32::INFINITY),
+            (Vec3::ZERO, -1.0),
+            (Vec3::ZERO, f32::NAN),
+        ] {
+            assert_eq!(bf.closest_point(p, r), None, "{p} {r}");
+            assert_eq!(bf.closest_point_counted(p, r, &mut c), None, "{p} {r}");
+        }
+        assert_eq!(c.prim_tests, 0, "rejected before any test");
+    }
+
+    #[test]
+    fn closest_point_on_zero_area_triangle_and_empty_mesh() {
+        let a = Vec3::new(1.0, 2.0, 3.0);
+        let point = Triangle::new(a, a, a);
+        let segment = Triangle::new(Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::X);
+        let mesh = TriangleMesh::from_triangles(&[point, segment]).unwrap().0;
+        let bf = BruteForce::build(Arc::new(mesh), &Default::default()).unwrap();
+        let h = bf
+            .closest_point(Vec3::new(1.0, 2.0, 4.0), f32::INFINITY)
+            .unwrap();
+        assert_eq!((h.prim, h.point, h.distance), (0, a, 1.0));
+        let h = bf
+            .closest_point(Vec3::new(1.5, -2.0, 0.0), f32::INFINITY)
+            .unwrap();
+        assert_eq!(
+            (h.prim, h.point, h.distance),
+            (1, Vec3::new(1.5, 0.0, 0.0), 2.0)
+        );
+
+        let (empty, _) = TriangleMesh::new(vec![], vec![]).unwrap();
+        let bf = BruteForce::build(Arc::new(empty), &Default::default()).unwrap();
+        assert_eq!(bf.closest_point(Vec3::ZERO, f32::INFINITY), None);
     }
 
     #[test]

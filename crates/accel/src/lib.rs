@@ -10,13 +10,15 @@ mod brute;
 pub mod compare;
 mod counters;
 mod mailbox;
+mod nearest;
 
 pub use brute::{BruteForce, BruteForceParams};
 pub use counters::{CounterSink, Counters, NoCount};
 pub use mailbox::Mailbox;
+pub use nearest::Nearest;
 pub use raybench_geom as geom;
 
-use raybench_geom::{Ray, TriangleMesh};
+use raybench_geom::{Ray, TriangleMesh, Vec3};
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::collections::BTreeMap;
@@ -33,6 +35,15 @@ pub struct Hit {
     pub u: f32,
     /// Barycentric weight of the triangle's third vertex (Embree's `v`).
     pub v: f32,
+}
+
+/// The answer to a closest-point query: the triangle nearest to the query point, the point on
+/// it, and the Euclidean distance (`|point - query|`, computed in f32).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointHit {
+    pub prim: u32,
+    pub point: Vec3,
+    pub distance: f32,
 }
 
 /// Shape of the built structure, for reports. The SAH cost uses the shared constants
@@ -115,6 +126,18 @@ pub trait Accel: Send + Sync {
     /// The same walk as [`Accel::intersect`], counting its work.
     fn intersect_counted(&self, ray: &Ray, c: &mut Counters) -> Option<Hit>;
     fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool;
+
+    /// Closest point: the triangle nearest to `p` within `max_radius` (inclusive:
+    /// `distance <= max_radius`), `None` when no triangle is that close. `max_radius` may be
+    /// `f32::INFINITY`. Zero-area triangles count (they have points). Every structure keeps its
+    /// best answer in a [`Nearest`], so the rules are one: the lower prim index wins a tie, and
+    /// a query Embree cannot take (a non-finite point, a coordinate beyond 1.844e18, a negative
+    /// or NaN radius) is answered `None`.
+    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit>;
+    /// The same walk as [`Accel::closest_point`], counting nodes, leaves, cells and
+    /// point–triangle distance tests (in `prim_tests`).
+    fn closest_point_counted(&self, p: Vec3, max_radius: f32, c: &mut Counters)
+    -> Option<PointHit>;
 
     fn build_stats(&self) -> BuildStats;
     fn memory(&self) -> Memory;

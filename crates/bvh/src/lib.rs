@@ -14,15 +14,19 @@
 //! | `bvh-binned` | binned SAH (Wald 2007) | ordered |
 //! | `bvh-binned-unordered` | binned SAH | fixed child order |
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 pub mod build;
 mod node;
+mod point;
 mod simd;
 mod traverse;
+pub mod tri4;
 mod validate;
 pub mod wide;
 
 pub use node::{ChildRef, MAX_DEPTH, Node};
-pub use wide::{Bvh8, Bvh8Params};
+pub use wide::{Bvh8, Bvh8Params, NodeSimd};
 
 use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount};
 use raybench_geom::{MollerTriangle, Ray, TriangleMesh};
@@ -52,6 +56,9 @@ pub struct BvhParams {
     pub traversal_cost: f32,
     /// SAH cost of one ray–triangle test, for the builder's split decisions.
     pub intersection_cost: f32,
+    /// Triangles tested together in a leaf (1: one at a time; 4: the wide BVH's SIMD packets).
+    /// The SAH prices a leaf by the packets it fills, so a leaf of 3 costs as much as one of 4.
+    pub leaf_block: u32,
     /// A node with more triangles than this is always split (if its triangles can be told
     /// apart at all; see `build`).
     pub max_leaf_size: u32,
@@ -74,6 +81,7 @@ impl BvhParams {
             bins: 32,
             traversal_cost: 1.0,
             intersection_cost: 1.0,
+            leaf_block: 1,
             max_leaf_size: 8,
             ordered: true,
             parallel_threshold: 4096,
@@ -126,6 +134,9 @@ pub struct Bvh {
     root_bounds: raybench_geom::Aabb,
     triangles: Vec<MollerTriangle>,
     prim_ids: Vec<u32>,
+    /// The mesh as built, for closest-point queries (exact vertices, not the ray layout's
+    /// rounded edges).
+    mesh: Arc<TriangleMesh>,
 }
 
 impl Bvh {
@@ -170,6 +181,7 @@ impl Accel for Bvh {
             root_bounds: flat.root_bounds,
             triangles,
             prim_ids: flat.prim_ids,
+            mesh,
         })
     }
 
@@ -199,6 +211,23 @@ impl Accel for Bvh {
 
     fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
         self.trace::<true, false, _>(ray, c).is_some()
+    }
+
+    fn closest_point(
+        &self,
+        p: raybench_geom::Vec3,
+        max_radius: f32,
+    ) -> Option<raybench_accel::PointHit> {
+        point::closest_point_binary(self, p, max_radius, &mut NoCount)
+    }
+
+    fn closest_point_counted(
+        &self,
+        p: raybench_geom::Vec3,
+        max_radius: f32,
+        c: &mut Counters,
+    ) -> Option<raybench_accel::PointHit> {
+        point::closest_point_binary(self, p, max_radius, c)
     }
 
     fn build_stats(&self) -> BuildStats {

@@ -72,6 +72,31 @@ fn wide_conforms() {
     assert_eq!(counts.mismatch, 0);
 }
 
+/// The SSE node kernel (what a CPU without AVX2 runs) answers like the AVX2 one: the same
+/// suite, and the same hits and counters ray for ray on a seeded scene.
+#[test]
+fn wide_sse_kernel_conforms_and_matches_the_default() {
+    use raybench_accel::{Accel, Counters};
+    let sse = Bvh8Params {
+        node_simd: raybench_bvh::NodeSimd::Sse,
+        ..Bvh8Params::default()
+    };
+    let counts = conformance::<Bvh8>(&sse, &|b, mesh| b.validate(mesh));
+    assert_eq!(counts.mismatch, 0);
+    let mesh = raybench_scenes::generate("teapot:triangles=5000", 1)
+        .expect("generates")
+        .mesh;
+    let a = Bvh8::build(mesh.clone(), &Bvh8Params::default()).expect("builds");
+    let b = Bvh8::build(mesh.clone(), &sse).expect("builds");
+    assert!(!b.uses_avx2());
+    for ray in raybench_scenes::random_rays(&mesh.bounds(), 5_000, 7) {
+        let (mut ca, mut cb) = (Counters::default(), Counters::default());
+        assert_eq!(a.intersect_counted(&ray, &mut ca), b.intersect_counted(&ray, &mut cb));
+        assert_eq!(a.occluded(&ray), b.occluded(&ray));
+        assert_eq!(ca, cb, "{ray:?}");
+    }
+}
+
 #[test]
 fn wide_conforms_on_the_shared_scenes() {
     let checked =
@@ -79,4 +104,56 @@ fn wide_conforms_on_the_shared_scenes() {
             b.validate(m)
         });
     eprintln!("real scenes checked: {checked}");
+}
+
+// ---- Closest-point queries --------------------------------------------------------------
+
+/// Closest-point queries against brute force on the shared point suite, for every binary
+/// variant (the walk ignores `ordered`: it always visits the nearer child first).
+#[test]
+fn binary_point_queries_conform() {
+    use raybench_testkit::points::point_conformance;
+    for params in [
+        BvhParams::median(),
+        BvhParams::sweep(),
+        BvhParams::binned(),
+        BvhParams {
+            max_leaf_size: 1,
+            bins: 2,
+            ..BvhParams::binned()
+        },
+    ] {
+        let counts = point_conformance::<Bvh>(&params, &|b, m| b.validate(m));
+        assert_eq!(counts.mismatch, 0, "{}", params.name());
+    }
+}
+
+#[test]
+fn wide_point_queries_conform() {
+    use raybench_testkit::points::point_conformance;
+    let tiny = Bvh8Params {
+        binary: BvhParams {
+            max_leaf_size: 1,
+            ..BvhParams::binned()
+        },
+        ..Bvh8Params::default()
+    };
+    for params in [Bvh8Params::default(), tiny] {
+        let counts = point_conformance::<Bvh8>(&params, &|b, m| b.validate(m));
+        assert_eq!(counts.mismatch, 0, "{params:?}");
+    }
+}
+
+#[test]
+fn point_queries_conform_on_the_shared_scenes() {
+    use raybench_testkit::points::point_conformance_on_shared_scenes;
+    let binary =
+        point_conformance_on_shared_scenes::<Bvh>(&BvhParams::binned(), &|b, m| b.validate(m), 70, 30);
+    let wide = point_conformance_on_shared_scenes::<Bvh8>(
+        &Bvh8Params::default(),
+        &|b, m| b.validate(m),
+        70,
+        30,
+    );
+    eprintln!("point queries checked on {binary} + {wide} shared scenes");
 }

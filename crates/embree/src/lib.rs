@@ -16,6 +16,7 @@ mod error;
 pub mod fpu;
 mod info;
 mod params;
+mod point;
 mod rays;
 mod scene;
 

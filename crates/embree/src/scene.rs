@@ -5,9 +5,11 @@ use crate::device::Device;
 use crate::error::{EmbreeError, InvalidRay};
 use crate::params::EmbreeParams;
 use crate::rays::{PreparedEmbreeRays, ValidRay, hit_of, occluded_of};
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PreparedRays};
+use raybench_accel::{
+    Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit, PreparedRays,
+};
 use raybench_embree_sys::{self as sys, intersect_context};
-use raybench_geom::{Ray, RayError, TriangleMesh};
+use raybench_geom::{Ray, RayError, TriangleMesh, Vec3};
 use std::ffi::c_void;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -65,9 +67,12 @@ pub struct EmbreeScene {
 // rtcOccluded1 on one committed scene from any number of threads at once (rtcIntersect1(3);
 // RenderKit/embree#207). Building happens in `build` before the value exists; dropping
 // happens with exclusive access. So moving it between threads and sharing `&EmbreeScene` is
-// sound. The other fields are Send + Sync on their own.
+// sound. The same holds for rtcPointQuery, which only reads the committed scene (each query
+// has its own query, context and callback state; rtcPointQuery(3) even allows nested calls).
+// The other fields are Send + Sync on their own.
 unsafe impl Send for OwnedScene {}
-// SAFETY: see `Send` above: through `&OwnedScene` only ray queries on the committed scene run.
+// SAFETY: see `Send` above: through `&OwnedScene` only ray and point queries on the committed
+// scene run.
 unsafe impl Sync for OwnedScene {}
 
 impl EmbreeScene {
@@ -290,6 +295,26 @@ impl Accel for EmbreeScene {
 
     fn occluded_counted(&self, ray: &Ray, _c: &mut Counters) -> bool {
         self.occluded(ray)
+    }
+
+    /// `rtcPointQuery` with a callback computing the same point–triangle distance as every
+    /// other structure (see `point.rs`). A query with no answer by definition (non-finite or
+    /// huge point, negative or NaN radius) returns `None` without reaching Embree.
+    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
+        // SAFETY: `self.scene` is committed and alive for as long as `self`, and `build_on`
+        // attached exactly `self.mesh`'s triangles in order as its only geometry (none when
+        // the mesh is empty).
+        unsafe { crate::point::closest_point(self.scene.0, &self.mesh, p, max_radius) }
+    }
+
+    /// Embree's work cannot be counted: same answer, counters untouched.
+    fn closest_point_counted(
+        &self,
+        p: Vec3,
+        max_radius: f32,
+        _c: &mut Counters,
+    ) -> Option<PointHit> {
+        self.closest_point(p, max_radius)
     }
 
     fn has_counters(&self) -> bool {

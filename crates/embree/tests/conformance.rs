@@ -32,3 +32,31 @@ fn embree_high_conforms() {
 fn embree_robust_conforms() {
     check(EmbreeParams::robust());
 }
+
+/// Closest-point queries (`rtcPointQuery`) against brute force on the shared point suite:
+/// every preset, zero mismatches.
+#[test]
+fn embree_point_queries_conform() {
+    use raybench_testkit::points::point_conformance;
+    for params in [
+        EmbreeParams::low(),
+        EmbreeParams::medium(),
+        EmbreeParams::high(),
+        EmbreeParams::robust(),
+    ] {
+        let counts = point_conformance::<EmbreeScene>(&params, &no_validation);
+        assert_eq!(counts.mismatch, 0, "{params:?}");
+    }
+}
+
+#[test]
+fn embree_point_queries_conform_on_the_shared_scenes() {
+    use raybench_testkit::points::point_conformance_on_shared_scenes;
+    let checked = point_conformance_on_shared_scenes::<EmbreeScene>(
+        &EmbreeParams::medium(),
+        &no_validation,
+        70,
+        30,
+    );
+    eprintln!("point queries checked on {checked} shared scenes");
+}

@@ -7,12 +7,15 @@
 //! * [`Triangle`] and [`TriangleMesh`], with the two ray–triangle tests raybench uses:
 //!   Möller–Trumbore in the form Embree's fast mode uses, and the watertight test of
 //!   Woop, Benthin and Wald (2013).
+//! * [`closest_point_on_triangle`] (Ericson's region test) and [`box_distance_squared`], for
+//!   closest-point queries.
 //!
 //! No `unsafe`, no acceleration structures.
 #![forbid(unsafe_code)]
 
 mod aabb;
 mod mesh;
+mod point;
 mod ray;
 mod triangle;
 pub mod tribox;
@@ -20,6 +23,9 @@ pub mod tribox;
 pub use aabb::Aabb;
 pub use glam::{DVec3, Vec3};
 pub use mesh::{MeshError, RemovedTriangles, TriangleMesh};
+pub use point::{
+    box_distance_squared, closest_point_on_triangle, distance_to_triangle_f64, query_radius_squared,
+};
 pub use ray::{EMBREE_LARGE, Ray, RayError};
 pub use triangle::{MollerTriangle, TriHit, Triangle, TriangleTest};
 

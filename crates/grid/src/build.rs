@@ -34,6 +34,7 @@ use raybench_geom::tribox::{MARGIN_REL, TriBox};
 use raybench_geom::{Aabb, DVec3, MollerTriangle, Triangle, TriangleMesh};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The f64 geometry of a grid: resolution, cell planes and the insertion margin. Insertion and
@@ -256,7 +257,7 @@ fn too_large(needed_bytes: u64, params: &GridParams) -> BuildError {
     }
 }
 
-pub(crate) fn build(mesh: &TriangleMesh, params: &GridParams) -> Result<Grid, BuildError> {
+pub(crate) fn build(mesh: &Arc<TriangleMesh>, params: &GridParams) -> Result<Grid, BuildError> {
     let n = mesh.len();
     let bounds = mesh.bounds();
     let layout = Layout::new(&bounds, n, params);
@@ -367,6 +368,7 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &GridParams) -> Result<Grid, Bu
         refs,
         triangles,
         stats,
+        mesh: mesh.clone(),
     })
 }
 

@@ -7,7 +7,9 @@
 //! one entry per cell (plus one) into one reference array, built by a counting sort
 //! ([`build`]). Rays walk the cells they pierce in order with the 3D-DDA of Amanatides and Woo
 //! (1987), test each triangle once thanks to a small on-stack mailbox, and stop in the first
-//! cell whose exit lies beyond the closest hit ([`traverse`]).
+//! cell whose exit lies beyond the closest hit ([`traverse`]). Closest-point queries visit the
+//! cells in expanding shells around the point's cell and stop when the next shell is farther
+//! than the nearest triangle found (`points.rs`).
 //!
 //! Three registered variants show the "too few / too many cells" trade-off:
 //!
@@ -24,11 +26,12 @@
 
 pub mod build;
 mod packet;
+mod points;
 mod traverse;
 mod validate;
 
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount};
-use raybench_geom::{Aabb, Ray, TriangleMesh};
+use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount, PointHit};
+use raybench_geom::{Aabb, Ray, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -128,6 +131,9 @@ pub struct Grid {
     /// `i / 4`.
     triangles: Vec<packet::Packet>,
     stats: BuildStats,
+    /// The mesh, for the exact vertices closest-point queries need (the packets hold
+    /// Möller–Trumbore's edge form, which does not give the vertices back bit for bit).
+    mesh: Arc<TriangleMesh>,
 }
 
 impl Grid {
@@ -192,6 +198,19 @@ impl Accel for Grid {
 
     fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
         self.trace::<true, _>(ray, c).is_some()
+    }
+
+    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
+        self.closest(p, max_radius, &mut NoCount)
+    }
+
+    fn closest_point_counted(
+        &self,
+        p: Vec3,
+        max_radius: f32,
+        c: &mut Counters,
+    ) -> Option<PointHit> {
+        self.closest(p, max_radius, c)
     }
 
     fn build_stats(&self) -> BuildStats {

@@ -5,6 +5,7 @@
 use raybench_accel::{Accel, BuildError};
 use raybench_geom::{Ray, TriangleMesh, Vec3};
 use raybench_grid::{Grid, GridParams};
+use raybench_testkit::points::{point_conformance, point_conformance_on_shared_scenes};
 use raybench_testkit::{Case, check_case, conformance, lattice_rays, lattice_scene};
 use std::sync::Arc;
 
@@ -139,4 +140,35 @@ fn walks_are_bounded_and_counted() {
         let _ = grid.intersect_counted(&r, &mut c);
         assert!(c.cells <= 24, "{r:?}: {c:?}");
     }
+}
+
+// ---- Closest-point queries --------------------------------------------------------------
+
+#[test]
+fn point_queries_conform() {
+    for params in [
+        GridParams::default(),
+        GridParams::coarse(),
+        GridParams::fine(),
+        // One cell for everything, and a dense grid capped at 8 cells per axis.
+        GridParams::with_density(1e-6),
+        GridParams {
+            max_resolution: 8,
+            ..GridParams::with_density(64.0)
+        },
+    ] {
+        let counts = point_conformance::<Grid>(&params, &|g, m| g.validate(m));
+        assert_eq!(counts.mismatch, 0, "{}", params.name());
+    }
+}
+
+#[test]
+fn point_queries_conform_on_the_shared_scenes() {
+    let checked = point_conformance_on_shared_scenes::<Grid>(
+        &GridParams::default(),
+        &|g, m| g.validate(m),
+        70,
+        30,
+    );
+    eprintln!("real scenes checked: {checked}");
 }

@@ -4,8 +4,10 @@
 //! them strictly front to back and may stop at the first cell that yields a hit, at the price
 //! of triangles referenced by every cell they cross. Built in place into a depth-first array of
 //! 8-byte nodes plus one reference array ([`build`], [`Node`]), traversed from that flat form
-//! with a small on-stack mailbox (`traverse.rs` has the details). Two registered variants share
-//! the code:
+//! with a small on-stack mailbox (`traverse.rs` has the details). Closest-point queries walk
+//! the same tree nearest child first, pruned by the distance to each cell (`points.rs`); the
+//! zero-area triangles rays never hit live in a side tree only they walk. Two registered
+//! variants share the code:
 //!
 //! | name | builder | reference |
 //! |---|---|---|
@@ -16,13 +18,15 @@
 pub mod build;
 pub mod clip;
 mod node;
+mod points;
 mod traverse;
 mod validate;
 
 pub use node::{MAX_DEPTH, Node};
 
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount};
-use raybench_geom::{Aabb, MollerTriangle, Ray, TriangleMesh};
+use build::Selection;
+use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount, PointHit};
+use raybench_geom::{Aabb, MollerTriangle, Ray, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -138,6 +142,14 @@ pub struct KdTree {
     /// The depth limit the build used (the resolved `max_depth`).
     depth_limit: u32,
     stats: BuildStats,
+    /// Which triangles this tree holds: the hittable ones, or (the side tree) the zero-area ones.
+    selection: Selection,
+    /// The mesh, for the exact vertices closest-point queries need (the stored triangles are
+    /// in Möller–Trumbore's edge form, which does not give the vertices back bit for bit).
+    mesh: Arc<TriangleMesh>,
+    /// The zero-area triangles rays never hit, in a tree of their own that only closest-point
+    /// queries walk (`None` when the mesh has none; see [`build`]).
+    zero_area: Option<Box<KdTree>>,
 }
 
 impl KdTree {
@@ -184,18 +196,15 @@ impl Accel for KdTree {
                  max_refs_per_triangle >= 1 (got {params:?})"
             )));
         }
-        let flat = build::build(&mesh, params)?;
-        Ok(KdTree {
-            name: params.name(),
-            params: params.clone(),
-            nodes: flat.nodes,
-            refs: flat.refs,
-            triangles: flat.triangles,
-            prim_ids: flat.prim_ids,
-            bounds: flat.bounds,
-            depth_limit: flat.depth_limit,
-            stats: flat.stats,
-        })
+        let mut tree = KdTree::from_flat(&mesh, params, Selection::Hittable)?;
+        if mesh.triangles().any(|t| Selection::ZeroArea.holds(&t)) {
+            let side = KdTree::from_flat(&mesh, params, Selection::ZeroArea)?;
+            let extra = &mut tree.stats.extra;
+            extra.insert("zero_area_tree_nodes".into(), side.stats.nodes as f64);
+            extra.insert("zero_area_tree_refs".into(), side.stats.refs as f64);
+            tree.zero_area = Some(Box::new(side));
+        }
+        Ok(tree)
     }
 
     fn name(&self) -> &str {
@@ -234,16 +243,66 @@ impl Accel for KdTree {
         }
     }
 
+    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
+        self.closest(p, max_radius, &mut NoCount)
+    }
+
+    fn closest_point_counted(
+        &self,
+        p: Vec3,
+        max_radius: f32,
+        c: &mut Counters,
+    ) -> Option<PointHit> {
+        self.closest(p, max_radius, c)
+    }
+
     fn build_stats(&self) -> BuildStats {
         self.stats.clone()
     }
 
+    /// Both trees; the mesh the point queries read vertices from is the caller's, not counted.
     fn memory(&self) -> Memory {
-        Memory {
+        let own = Memory {
             nodes: std::mem::size_of_val(self.nodes.as_slice()) as u64,
             indices: (std::mem::size_of_val(self.refs.as_slice())
                 + std::mem::size_of_val(self.prim_ids.as_slice())) as u64,
             primitives: std::mem::size_of_val(self.triangles.as_slice()) as u64,
+        };
+        match &self.zero_area {
+            None => own,
+            Some(side) => {
+                let s = side.memory();
+                Memory {
+                    nodes: own.nodes + s.nodes,
+                    indices: own.indices + s.indices,
+                    primitives: own.primitives + s.primitives,
+                }
+            }
         }
+    }
+}
+
+impl KdTree {
+    /// Builds the tree over the `selection` of the mesh and flattens it.
+    fn from_flat(
+        mesh: &Arc<TriangleMesh>,
+        params: &KdParams,
+        selection: Selection,
+    ) -> Result<KdTree, BuildError> {
+        let flat = build::build(mesh, params, selection)?;
+        Ok(KdTree {
+            name: params.name(),
+            params: params.clone(),
+            nodes: flat.nodes,
+            refs: flat.refs,
+            triangles: flat.triangles,
+            prim_ids: flat.prim_ids,
+            bounds: flat.bounds,
+            depth_limit: flat.depth_limit,
+            stats: flat.stats,
+            selection,
+            mesh: mesh.clone(),
+            zero_area: None,
+        })
     }
 }

@@ -154,4 +154,4 @@ impl KdTree {
 }
 
 /// Stack entries for trees at most this deep (see [`KdTree::trace`]).
-const SMALL_STACK: usize = 32;
+pub(crate) const SMALL_STACK: usize = 32;

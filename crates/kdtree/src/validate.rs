@@ -20,17 +20,34 @@
 //!   clipping finds empty in a child (only possible within rounding of the plane) keeps its
 //!   bounds cut to that child. A reference this adds is allowed, because the walk uses the same
 //!   function.
-//! * Triangles whose precomputed normal is zero (never hit) must not be referenced at all.
+//! * Triangles whose precomputed normal is zero (never hit) must not be referenced at all;
+//!   they must all be in the zero-area side tree (closest-point queries only), which is
+//!   checked the same way with the selection reversed.
 
 use crate::KdTree;
+use crate::build::Selection;
 use crate::clip::{Side, halves, side, straddler_bounds};
 use crate::node::{LEAF, MAX_DEPTH, Node};
-use raybench_geom::{Aabb, MollerTriangle, Triangle, TriangleMesh, Vec3};
+use raybench_geom::{Aabb, MollerTriangle, Triangle, TriangleMesh};
 
 pub(crate) fn validate(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
+    validate_tree(kd, mesh)?;
+    let zero_area = mesh.triangles().any(|t| Selection::ZeroArea.holds(&t));
+    match &kd.zero_area {
+        Some(side) if side.selection == Selection::ZeroArea && side.zero_area.is_none() => {
+            validate_tree(side, mesh).map_err(|e| format!("zero-area side tree: {e}"))
+        }
+        Some(_) => Err("malformed zero-area side tree".into()),
+        None if zero_area => Err("zero-area triangles but no side tree".into()),
+        None => Ok(()),
+    }
+}
+
+/// One tree: the main one (hittable triangles) or the side one (zero-area triangles).
+fn validate_tree(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
     let n = mesh.len();
     // Stored triangles: a subset of the mesh without repeats, matching it, and holding every
-    // triangle that can be hit.
+    // triangle of the tree's selection (those a ray can hit, or the zero-area ones).
     if kd.triangles.len() != kd.prim_ids.len() {
         return Err("triangles and prim_ids differ in length".into());
     }
@@ -47,29 +64,29 @@ pub(crate) fn validate(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
             return Err(format!("triangle slot {i} is not mesh triangle {id}"));
         }
     }
-    let hittable: Vec<u32> = (0..n as u32)
-        .filter(|&i| MollerTriangle::new(&mesh.triangle(i as usize)).ng != Vec3::ZERO)
+    let selected: Vec<u32> = (0..n as u32)
+        .filter(|&i| kd.selection.holds(&mesh.triangle(i as usize)))
         .collect();
-    for &i in &hittable {
+    for &i in &selected {
         if slot_of[i as usize] == u32::MAX {
-            return Err(format!("triangle {i} can be hit but is not in the tree"));
+            return Err(format!("triangle {i} is selected but not in the tree"));
         }
     }
-    if kd.prim_ids.len() != hittable.len() {
+    if kd.prim_ids.len() != selected.len() {
         return Err(format!(
-            "{} triangles stored, {} can be hit",
+            "{} triangles stored, {} selected",
             kd.prim_ids.len(),
-            hittable.len()
+            selected.len()
         ));
     }
-    if hittable.is_empty() {
+    if selected.is_empty() {
         return if kd.nodes.is_empty() && kd.refs.is_empty() {
             Ok(())
         } else {
-            Err("nodes or references for a mesh with nothing to hit".into())
+            Err("nodes or references for a mesh with nothing selected".into())
         };
     }
-    for &i in &hittable {
+    for &i in &selected {
         if !kd.bounds.contains_box(&mesh.triangle(i as usize).bounds()) {
             return Err(format!("root cell does not contain triangle {i}"));
         }
@@ -115,7 +132,7 @@ pub(crate) fn validate(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
     }
     actual.sort_unstable();
     let mut allowed: Vec<(u32, u32)> = Vec::with_capacity(kd.refs.len());
-    for &i in &hittable {
+    for &i in &selected {
         let tri = mesh.triangle(i as usize);
         let slot = slot_of[i as usize];
         let mut walk = Walk {

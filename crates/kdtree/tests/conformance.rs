@@ -1,8 +1,10 @@
 //! The shared conformance suite for both k-d tree variants and for extreme knobs, with
-//! `validate()` after every build; the real scenes of ../shared/scenes for kd-sah.
+//! `validate()` after every build; the real scenes of ../shared/scenes for kd-sah; the same
+//! for closest-point queries (testkit's point suite, every variant).
 
 use raybench_kdtree::{KdParams, KdTree};
 use raybench_testkit::conformance;
+use raybench_testkit::points::{point_conformance, point_conformance_on_shared_scenes};
 
 fn check(params: KdParams) {
     let counts = conformance::<KdTree>(&params, &|kd, mesh| kd.validate(mesh));
@@ -66,5 +68,44 @@ fn sah_conforms_on_the_shared_scenes() {
         raybench_testkit::conformance_on_shared_scenes::<KdTree>(&KdParams::sah(), &|kd, m| {
             kd.validate(m)
         });
+    eprintln!("real scenes checked: {checked}");
+}
+
+// ---- Closest-point queries --------------------------------------------------------------
+
+#[test]
+fn point_queries_conform() {
+    for params in [
+        KdParams::sah(),
+        KdParams::median(),
+        KdParams {
+            mailbox: false,
+            ..KdParams::sah()
+        },
+        // One leaf holding everything, and deep trees with tiny leaves up to the budget.
+        KdParams {
+            max_depth: Some(0),
+            ..KdParams::sah()
+        },
+        KdParams {
+            traversal_cost: 0.0,
+            empty_bonus: 1.0,
+            max_refs_per_triangle: 4.0,
+            ..KdParams::sah()
+        },
+    ] {
+        let counts = point_conformance::<KdTree>(&params, &|kd, m| kd.validate(m));
+        assert_eq!(counts.mismatch, 0, "{}", params.name());
+    }
+}
+
+#[test]
+fn point_queries_conform_on_the_shared_scenes() {
+    let checked = point_conformance_on_shared_scenes::<KdTree>(
+        &KdParams::sah(),
+        &|kd, m| kd.validate(m),
+        70,
+        30,
+    );
     eprintln!("real scenes checked: {checked}");
 }

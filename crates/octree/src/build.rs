@@ -35,6 +35,7 @@ use raybench_geom::tribox::{TriBox, conservative_box};
 use raybench_geom::{Aabb, DVec3, MollerTriangle, TriangleMesh, Vec3};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 enum BuildNode {
@@ -81,7 +82,7 @@ pub fn enlarged(lo: Vec3, hi: Vec3) -> (DVec3, DVec3) {
     conservative_box(lo.as_dvec3(), hi.as_dvec3())
 }
 
-pub(crate) fn build(mesh: &TriangleMesh, params: &OctreeParams) -> Result<Octree, BuildError> {
+pub(crate) fn build(mesh: &Arc<TriangleMesh>, params: &OctreeParams) -> Result<Octree, BuildError> {
     let n = mesh.len();
     let triangles: Vec<MollerTriangle> = (0..n)
         .into_par_iter()
@@ -130,6 +131,7 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &OctreeParams) -> Result<Octree
         refs,
         triangles,
         stats,
+        mesh: mesh.clone(),
     })
 }
 

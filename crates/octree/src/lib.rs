@@ -9,7 +9,8 @@
 //! back — at each node the ray's crossings of the three centre planes, sorted, give the
 //! children in the order the ray enters them — and stop at the first leaf whose exit lies at
 //! or beyond the closest hit, testing each triangle once thanks to a small mailbox
-//! ([`traverse`]).
+//! ([`traverse`]). Closest-point queries descend nearest octant first and skip every octant
+//! farther than the nearest triangle found so far (`points.rs`).
 //!
 //! Against the uniform grid: the octree adapts its cell size to where the triangles are, so a
 //! teapot in a stadium is subdivided down to its own scale while the empty stands stay coarse;
@@ -18,13 +19,14 @@
 
 pub mod build;
 mod node;
+mod points;
 mod traverse;
 mod validate;
 
 pub use node::{MAX_DEPTH_LIMIT, Node};
 
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount};
-use raybench_geom::{Aabb, MollerTriangle, Ray, TriangleMesh};
+use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount, PointHit};
+use raybench_geom::{Aabb, MollerTriangle, Ray, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -103,6 +105,9 @@ pub struct Octree {
     refs: Vec<u32>,
     triangles: Vec<MollerTriangle>,
     stats: BuildStats,
+    /// The mesh, for the exact vertices closest-point queries need (the stored triangles are
+    /// in Möller–Trumbore's edge form, which does not give the vertices back bit for bit).
+    mesh: Arc<TriangleMesh>,
 }
 
 impl Octree {
@@ -154,6 +159,19 @@ impl Accel for Octree {
 
     fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
         self.trace::<true, _>(ray, c).is_some()
+    }
+
+    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
+        self.closest(p, max_radius, &mut NoCount)
+    }
+
+    fn closest_point_counted(
+        &self,
+        p: Vec3,
+        max_radius: f32,
+        c: &mut Counters,
+    ) -> Option<PointHit> {
+        self.closest(p, max_radius, c)
     }
 
     fn build_stats(&self) -> BuildStats {

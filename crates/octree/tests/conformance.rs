@@ -5,6 +5,7 @@
 use raybench_accel::{Accel, BuildError, Counters};
 use raybench_geom::{Ray, Vec3};
 use raybench_octree::{Octree, OctreeParams};
+use raybench_testkit::points::{point_conformance, point_conformance_on_shared_scenes};
 use raybench_testkit::{Case, check_case, conformance, lattice_rays, lattice_scene};
 
 fn check(params: OctreeParams) {
@@ -145,4 +146,37 @@ fn walks_are_bounded_and_counted() {
         let _ = tree.intersect_counted(&r, &mut c);
         assert!(c.nodes + c.leaves <= 64, "{r:?}: {c:?}");
     }
+}
+
+// ---- Closest-point queries --------------------------------------------------------------
+
+#[test]
+fn point_queries_conform() {
+    for params in [
+        OctreeParams::default(),
+        // One triangle per leaf as deep as allowed, and a single leaf.
+        OctreeParams {
+            max_obj: 1,
+            max_depth: raybench_octree::MAX_DEPTH_LIMIT,
+            ..OctreeParams::default()
+        },
+        OctreeParams {
+            max_depth: 0,
+            ..OctreeParams::default()
+        },
+    ] {
+        let counts = point_conformance::<Octree>(&params, &|t, m| t.validate(m));
+        assert_eq!(counts.mismatch, 0, "{}", params.name());
+    }
+}
+
+#[test]
+fn point_queries_conform_on_the_shared_scenes() {
+    let checked = point_conformance_on_shared_scenes::<Octree>(
+        &OctreeParams::default(),
+        &|t, m| t.validate(m),
+        70,
+        30,
+    );
+    eprintln!("real scenes checked: {checked}");
 }

@@ -12,6 +12,7 @@ mod error;
 mod generate;
 mod material;
 mod obj;
+pub mod points;
 mod rng;
 mod suite;
 mod view;

@@ -18,6 +18,7 @@
 
 pub mod bench;
 mod cases;
+pub mod points;
 mod rays;
 
 pub use cases::{Case, edge_cases, lattice_scene, seeded_cases};

@@ -41,13 +41,21 @@ impl Split {
 /// areas: only their ratios matter.
 fn split_cost(p: &BvhParams, parent: f64, left: (f64, usize), right: (f64, usize)) -> f64 {
     p.traversal_cost as f64
-        + p.intersection_cost as f64 * (left.0 * left.1 as f64 + right.0 * right.1 as f64) / parent
+        + p.intersection_cost as f64
+            * (left.0 * blocks(p, left.1) + right.0 * blocks(p, right.1))
+            / parent
+}
+
+/// The triangle tests a leaf of `n` costs: `n` rounded up to whole packets of `leaf_block`.
+fn blocks(p: &BvhParams, n: usize) -> f64 {
+    let block = p.leaf_block.max(1) as usize;
+    n.div_ceil(block) as f64 * block as f64
 }
 
 /// Whether the best split is worth taking: always when the range is too big for a leaf,
 /// otherwise only when it is cheaper than intersecting every triangle.
 fn worth_splitting(p: &BvhParams, n: usize, best_cost: f64) -> bool {
-    n > p.max_leaf_size as usize || best_cost < p.intersection_cost as f64 * n as f64
+    n > p.max_leaf_size as usize || best_cost < p.intersection_cost as f64 * blocks(p, n)
 }
 
 /// Object median: the textbook baseline. Splits any range larger than a leaf at the median

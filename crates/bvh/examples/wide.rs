@@ -1,0 +1,116 @@
+//! Times the 8-wide BVH next to embree-medium on one scene, outside the harness, for quick
+//! before/after checks of traversal changes on a shared, noisy machine: each round times every
+//! structure once per workload, interleaved, and the figures printed are each structure's best
+//! pass (the one least disturbed by other processes) and its ratio to Embree's best pass.
+//! Short passes and many rounds make an undisturbed pass likely.
+//!
+//! `cargo run --release -p raybench-bvh --example wide -- ../shared/scenes/stanford-bunny.obj 50000 20`
+//! (scene, rays per workload, rounds, optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round.
+
+use raybench_accel::{Accel, PreparedRays};
+use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams, NodeSimd};
+use raybench_embree::{EmbreeParams, EmbreeScene};
+use raybench_geom::Ray;
+use raybench_scenes::SurfaceHit;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Rays per second of one pass (closest hit, or any hit for shadow rays), in millions.
+fn mrays(accel: &dyn Accel, rays: &[Ray], prepared: &PreparedRays, any_hit: bool) -> f64 {
+    let start = Instant::now();
+    if any_hit {
+        let mut out = vec![false; rays.len()];
+        accel.occluded_prepared(rays, prepared, 0, &mut out);
+        std::hint::black_box(&out);
+    } else {
+        let mut out = vec![None; rays.len()];
+        accel.intersect_prepared(rays, prepared, 0, &mut out);
+        std::hint::black_box(&out);
+    }
+    rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6
+}
+
+fn best(v: &[f64]) -> f64 {
+    v.iter().copied().fold(0.0, f64::max)
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let path = args.next().unwrap_or("../shared/scenes/stanford-bunny.obj".into());
+    let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(50_000);
+    let rounds: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);
+    let only = args.next(); // one workload's name, to profile it alone
+    let scene = raybench_scenes::load_obj(std::path::Path::new(&path)).expect("scene loads");
+    let mesh = Arc::clone(&scene.mesh);
+    let bounds = mesh.bounds();
+
+    let mut structures: Vec<(String, Box<dyn Accel>, f64)> = Vec::new();
+    let mut add = |name: &str, build: &dyn Fn() -> Box<dyn Accel>| {
+        let start = Instant::now();
+        let accel = build();
+        structures.push((name.into(), accel, start.elapsed().as_secs_f64() * 1e3));
+    };
+    add("embree-medium", &|| {
+        Box::new(EmbreeScene::build(Arc::clone(&mesh), &EmbreeParams::medium()).expect("builds"))
+    });
+    add("bvh-binned", &|| {
+        Box::new(Bvh::build(Arc::clone(&mesh), &BvhParams::binned()).expect("builds"))
+    });
+    add("bvh8", &|| {
+        Box::new(Bvh8::build(Arc::clone(&mesh), &Bvh8Params::default()).expect("builds"))
+    });
+    let sse = Bvh8Params {
+        node_simd: NodeSimd::Sse,
+        ..Bvh8Params::default()
+    };
+    add("bvh8-sse", &|| {
+        Box::new(Bvh8::build(Arc::clone(&mesh), &sse).expect("builds"))
+    });
+
+    let primary = raybench_scenes::primary_rays(&scene.view, &bounds, n).0;
+    let reference = &structures[0].1;
+    let hits: Vec<Option<SurfaceHit>> = primary
+        .iter()
+        .map(|r| {
+            reference.intersect(r).map(|h| SurfaceHit {
+                prim: h.prim,
+                u: h.u,
+                v: h.v,
+            })
+        })
+        .collect();
+    let workloads = [
+        ("primary", primary.clone(), false),
+        ("random", raybench_scenes::random_rays(&bounds, n, 1), false),
+        (
+            "shadow",
+            raybench_scenes::shadow_rays(&mesh, scene.view.light, &primary, &hits),
+            true,
+        ),
+    ];
+    for (name, rays, any_hit) in &workloads {
+        if only.as_deref().is_some_and(|o| o != *name) {
+            continue;
+        }
+        let prepared: Vec<PreparedRays> = structures
+            .iter()
+            .map(|(_, a, _)| a.prepare_rays(rays).expect("valid rays"))
+            .collect();
+        let mut rates = vec![Vec::new(); structures.len()];
+        for _ in 0..rounds + 1 {
+            for (k, (_, accel, _)) in structures.iter().enumerate() {
+                rates[k].push(mrays(accel.as_ref(), rays, &prepared[k], *any_hit));
+            }
+        }
+        for r in &mut rates {
+            r.remove(0); // the warm-up round
+        }
+        for (k, (label, _, build_ms)) in structures.iter().enumerate() {
+            println!(
+                "{name:8} {label:14} {:7.2} Mrays/s  {:5.3}x embree   (build {build_ms:6.1} ms)",
+                best(&rates[k]),
+                best(&rates[k]) / best(&rates[0])
+            );
+        }
+    }
+}
