@@ -5,7 +5,7 @@
 //! Mqueries/s over rounds and the median of the per-round ratio to Embree, plus nodes and
 //! point–triangle tests per query from one counted pass.
 //!
-//! `cargo run --release -p raybench-bvh --example points -- ../shared/scenes/stanford-bunny.obj 100000 7`
+//! `cargo run --release -p raybench-bvh --example points_bvh -- ../shared/scenes/stanford-bunny.obj 100000 7`
 //! (scene, points per workload, rounds).
 
 use raybench_accel::{Accel, Counters, PointHit};
