@@ -66,6 +66,9 @@ pub struct BvhParams {
     pub ordered: bool,
     /// Ranges larger than this are built on two rayon tasks and binned in parallel.
     pub parallel_threshold: u32,
+    /// The build refuses with [`BuildError::TooLarge`] when its estimate of the memory it
+    /// needs (taken before allocating anything) exceeds this.
+    pub memory_limit_bytes: u64,
 }
 
 impl Default for BvhParams {
@@ -75,6 +78,9 @@ impl Default for BvhParams {
 }
 
 impl BvhParams {
+    /// 8 GiB: a third of this VM's memory, as the grid and octree use.
+    pub const MEMORY_LIMIT: u64 = 8 << 30;
+
     pub fn binned() -> BvhParams {
         BvhParams {
             builder: Builder::Binned,
@@ -85,6 +91,7 @@ impl BvhParams {
             max_leaf_size: 8,
             ordered: true,
             parallel_threshold: 4096,
+            memory_limit_bytes: BvhParams::MEMORY_LIMIT,
         }
     }
     pub fn median() -> BvhParams {

@@ -157,3 +157,32 @@ fn point_queries_conform_on_the_shared_scenes() {
     );
     eprintln!("point queries checked on {binary} + {wide} shared scenes");
 }
+
+/// A scene too large for the memory limit is refused before anything is allocated, by both
+/// trees, with the estimate in the error.
+#[test]
+fn too_large_is_an_error_not_an_abort() {
+    use raybench_accel::{Accel, BuildError};
+    let mesh = raybench_scenes::generate("soup:triangles=2000", 1)
+        .expect("generates")
+        .mesh;
+    let small = BvhParams {
+        memory_limit_bytes: 64 * 1024,
+        ..BvhParams::binned()
+    };
+    let refused = |r: Result<(), BuildError>| match r {
+        Err(BuildError::TooLarge {
+            needed_bytes,
+            limit_bytes,
+        }) => assert!(needed_bytes > limit_bytes && limit_bytes == 64 * 1024),
+        other => panic!("expected TooLarge, got {other:?}"),
+    };
+    refused(Bvh::build(mesh.clone(), &small).map(|_| ()));
+    let wide = Bvh8Params {
+        binary: small.clone(),
+        ..Bvh8Params::default()
+    };
+    refused(Bvh8::build(mesh.clone(), &wide).map(|_| ()));
+    // The default limit builds it.
+    assert!(Bvh::build(mesh, &BvhParams::binned()).is_ok());
+}

@@ -69,6 +69,10 @@ pub struct KdParams {
     /// Nodes with more triangles than this build their two subtrees on two rayon tasks (near
     /// the root only: a handful of tasks per worker thread).
     pub parallel_threshold: u32,
+    /// The build refuses with [`BuildError::TooLarge`] when the memory it needs before the
+    /// first reference (triangle copies, event scratch) exceeds this, and otherwise lowers the
+    /// reference budget so references fit within it.
+    pub memory_limit_bytes: u64,
 }
 
 impl Default for KdParams {
@@ -78,6 +82,9 @@ impl Default for KdParams {
 }
 
 impl KdParams {
+    /// 8 GiB: a third of this VM's memory, as the grid and octree use.
+    pub const MEMORY_LIMIT: u64 = 8 << 30;
+
     /// `kd-sah`. `K_I / K_T = 0.75`: measured with `examples/kdtune.rs` on the bunny and
     /// Sponza (1 thread, 100k seeded random and primary rays, 2026-11-21) against 0.5, 1, 1.5
     /// (about Wald and Havran's 20/15) and 2. With 1.5 and above the SAH splits every cell down
@@ -98,6 +105,7 @@ impl KdParams {
             max_refs_per_triangle: 32.0,
             mailbox: true,
             parallel_threshold: 16_384,
+            memory_limit_bytes: KdParams::MEMORY_LIMIT,
         }
     }
 

@@ -109,3 +109,33 @@ fn point_queries_conform_on_the_shared_scenes() {
     );
     eprintln!("real scenes checked: {checked}");
 }
+
+/// A scene too large for the memory limit is refused before the build allocates anything; a
+/// limit that fits the triangles but few references caps the reference budget instead, and
+/// the tree is still correct.
+#[test]
+fn too_large_is_an_error_not_an_abort() {
+    use raybench_accel::{Accel, BuildError};
+    let mesh = raybench_scenes::generate("soup:triangles=2000", 1)
+        .expect("generates")
+        .mesh;
+    let tiny = KdParams {
+        memory_limit_bytes: 64 * 1024,
+        ..KdParams::sah()
+    };
+    match KdTree::build(mesh.clone(), &tiny) {
+        Err(BuildError::TooLarge {
+            needed_bytes,
+            limit_bytes,
+        }) => assert!(needed_bytes > limit_bytes),
+        other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
+    }
+    // Room for the triangles and about 1.5 references each: fewer splits, same answers.
+    let tight = KdParams {
+        memory_limit_bytes: 2000 * 116 + 3000 * 108,
+        ..KdParams::sah()
+    };
+    let tree = KdTree::build(mesh.clone(), &tight).expect("builds within the budget");
+    tree.validate(&mesh).expect("valid");
+    assert!(tree.build_stats().refs <= 3000, "{:?}", tree.build_stats());
+}

@@ -17,12 +17,14 @@ pub enum SceneError {
     #[error("{}: is a directory, not a file", .path.display())]
     IsDirectory { path: PathBuf },
 
-    /// Bytes that are not UTF-8; tobj would stop at the line with a bare "read error".
-    #[error("{}: line {line}: not UTF-8 text (invalid byte at column {column})", .path.display())]
+    /// Bytes that are not UTF-8; tobj would stop at the line with a bare "read error". `hint`
+    /// names a likely cause when the bytes show one (UTF-16, binary data), else it is empty.
+    #[error("{}: line {line}: not UTF-8 text (invalid byte at column {column}){hint}", .path.display())]
     NotUtf8 {
         path: PathBuf,
         line: usize,
         column: usize,
+        hint: &'static str,
     },
 
     /// A line the OBJ loader rejects. `line` is found by our own scan of the text, because tobj
@@ -44,7 +46,7 @@ pub enum SceneError {
     #[error("generator spec `{spec}`: {problem}")]
     Generator { spec: String, problem: String },
 
-    #[error("unknown workload `{name}` (known: primary, random, shadow, diffuse)")]
+    #[error("unknown workload `{name}` (known: primary, random, shadow, diffuse, whitted)")]
     UnknownWorkload { name: String },
 
     #[error("{}: not a valid suite manifest: {source}", .path.display())]

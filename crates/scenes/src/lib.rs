@@ -24,7 +24,7 @@ pub use generate::{
 };
 pub use material::Material;
 pub use obj::export::{in_file_order, write_obj};
-pub use obj::load_obj;
+pub use obj::{load_obj, load_obj_bytes};
 pub use suite::{Suite, SuiteScene, list_suites, load_suite, resolve_suite_scenes, suites_dir};
 pub use view::{Camera, View};
 pub use workload::{

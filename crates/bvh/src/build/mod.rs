@@ -39,8 +39,20 @@ pub(crate) struct Flat {
     pub root_bounds: Aabb,
 }
 
+/// Peak bytes per triangle of a build: its 32-byte record, up to one 64-byte node in the
+/// per-task vectors and again in the flattened array, its id, and its 48-byte triangle copy
+/// (or its share of a wide tree's packets and nodes, no more than that).
+const PEAK_BYTES_PER_TRIANGLE: u64 = 32 + 2 * 64 + 4 + 48;
+
 pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, BuildError> {
     let n = mesh.len();
+    let needed_bytes = n as u64 * PEAK_BYTES_PER_TRIANGLE;
+    if needed_bytes > params.memory_limit_bytes {
+        return Err(BuildError::TooLarge {
+            needed_bytes,
+            limit_bytes: params.memory_limit_bytes,
+        });
+    }
     if n > MAX_PRIMS {
         return Err(BuildError::Unsupported(format!(
             "{n} triangles; the BVH builder holds at most {MAX_PRIMS}"

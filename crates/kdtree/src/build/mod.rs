@@ -194,6 +194,7 @@ pub(crate) fn build(
     params: &KdParams,
     selection: Selection,
 ) -> Result<Flat, BuildError> {
+    let affordable_refs = reference_budget_within_memory(mesh.len(), params)?;
     let tris: Vec<Triangle> = mesh.triangles().collect();
     let ids: Vec<u32> = (0..tris.len() as u32)
         .filter(|&i| selection.holds(&tris[i as usize]))
@@ -213,7 +214,9 @@ pub(crate) fn build(
         .max_depth
         .unwrap_or_else(|| default_max_depth(n))
         .min(MAX_DEPTH as u32);
-    let max_refs = (n as f64 * params.max_refs_per_triangle as f64).min(u32::MAX as f64 / 2.0);
+    let max_refs = (n as f64 * params.max_refs_per_triangle as f64)
+        .min(u32::MAX as f64 / 2.0)
+        .min(affordable_refs as f64);
     let threads = rayon::current_num_threads();
     let ctx = Ctx {
         tris: &tris,
@@ -236,10 +239,11 @@ pub(crate) fn build(
         }
     }
     if out.nodes.len() > MAX_PACKED as usize || out.shape.max_leaf_size >= MAX_PACKED {
-        return Err(BuildError::TooLarge {
-            needed_bytes: (out.nodes.len() * 8 + out.refs.len() * 4) as u64,
-            limit_bytes: (MAX_PACKED as u64) * 8,
-        });
+        return Err(BuildError::Unsupported(format!(
+            "{} nodes (largest leaf {}): the packed node format holds at most {MAX_PACKED}",
+            out.nodes.len(),
+            out.shape.max_leaf_size
+        )));
     }
     // Triangles in the order leaves first reference them: a leaf's triangles sit together in
     // memory, and neighbouring leaves mostly share theirs.
@@ -300,4 +304,26 @@ fn stats(s: &Shape, n: usize, excluded: usize, depth_limit: u32, root_area: f64)
         sah_cost: (root_area > 0.0 && n > 0).then_some(s.sah),
         extra,
     }
+}
+
+/// Bytes a build needs per triangle before any reference exists: the triangle copied twice
+/// (36-byte corners, 48-byte ray layout), its id, its new index and its box.
+const FIXED_BYTES_PER_TRIANGLE: u64 = 36 + 48 + 4 + 4 + 24;
+/// Bytes live per reference at the peak of the SAH build: six 8-byte events and their radix
+/// sort scratch, the reference itself and its share of 8-byte nodes.
+const BYTES_PER_REF: u64 = 6 * 8 * 2 + 4 + 8;
+
+/// The most references the build may make within `params.memory_limit_bytes`, estimated before
+/// allocating anything; `TooLarge` when not even one reference per triangle fits.
+fn reference_budget_within_memory(n: usize, params: &KdParams) -> Result<u64, BuildError> {
+    let n = n as u64;
+    let fixed = n * FIXED_BYTES_PER_TRIANGLE;
+    let affordable = params.memory_limit_bytes.saturating_sub(fixed) / BYTES_PER_REF;
+    if affordable < n {
+        return Err(BuildError::TooLarge {
+            needed_bytes: fixed + n * BYTES_PER_REF,
+            limit_bytes: params.memory_limit_bytes,
+        });
+    }
+    Ok(affordable)
 }

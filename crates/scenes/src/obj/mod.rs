@@ -26,11 +26,20 @@ const FAR_COORDINATE: f32 = 1e7;
 
 /// Loads an OBJ file as a scene named after the file stem, with a default view from its bounds.
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
-    let text = read_text(path)?;
+    let bytes = read_bytes(path)?;
+    load_obj_bytes(path, &bytes)
+}
+
+/// Loads OBJ text already in memory, exactly as [`load_obj`] loads a file (which reads the file
+/// and calls this): `path` is never opened, it names the input in errors and names the scene.
+/// Any byte string gives a scene or a [`SceneError`], never a panic (the fuzz target in
+/// `fuzz/` feeds it arbitrary bytes).
+pub fn load_obj_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| not_utf8(path, bytes, e))?;
     // tobj would read a byte-order mark as part of the first keyword and skip that line.
     let (text, had_bom) = match text.strip_prefix('\u{feff}') {
         Some(rest) => (rest, true),
-        None => (text.as_str(), false),
+        None => (text, false),
     };
     let scan = scan::scan(text);
     if let Some(problem) = scan.first_problem.clone() {
@@ -79,15 +88,14 @@ fn scene_name(path: &Path) -> String {
         .unwrap_or_else(|| path.display().to_string())
 }
 
-fn read_text(path: &Path) -> Result<String, SceneError> {
+fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
     // Check for a directory first: on Linux `read` of a directory fails with a vague EISDIR.
     if path.is_dir() {
         return Err(SceneError::IsDirectory {
             path: path.to_owned(),
         });
     }
-    let bytes = std::fs::read(path).map_err(|e| SceneError::io(path, e))?;
-    String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))
+    std::fs::read(path).map_err(|e| SceneError::io(path, e))
 }
 
 fn not_utf8(path: &Path, bytes: &[u8], error: std::str::Utf8Error) -> SceneError {
@@ -97,6 +105,18 @@ fn not_utf8(path: &Path, bytes: &[u8], error: std::str::Utf8Error) -> SceneError
         path: path.to_owned(),
         line: good.iter().filter(|&&b| b == b'\n').count() + 1,
         column: good.len() - line_start + 1,
+        hint: not_utf8_hint(bytes),
+    }
+}
+
+/// The likely cause of bytes that are not UTF-8, from their first bytes.
+fn not_utf8_hint(bytes: &[u8]) -> &'static str {
+    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        "; it starts with a UTF-16 byte-order mark: save it as UTF-8"
+    } else if bytes.iter().take(512).any(|&b| b == 0) {
+        "; it contains NUL bytes: binary data, not an OBJ file"
+    } else {
+        ""
     }
 }
 
@@ -253,11 +273,19 @@ fn scan_notes(scan: &Scan) -> Vec<String> {
     notes
 }
 
+/// Counts the vertices of kept triangles (those of removed ones are not traced) that lie far
+/// from the origin.
 fn far_coordinate_note(mesh: &TriangleMesh) -> Option<String> {
+    let mut used = vec![false; mesh.positions().len()];
+    mesh.indices()
+        .iter()
+        .flatten()
+        .for_each(|&i| used[i as usize] = true);
     let far = mesh
         .positions()
         .iter()
-        .filter(|p| p.is_finite() && p.abs().max_element() > FAR_COORDINATE)
+        .zip(&used)
+        .filter(|&(p, &used)| used && p.abs().max_element() > FAR_COORDINATE)
         .count();
     (far > 0).then(|| {
         format!(
@@ -280,6 +308,29 @@ mod tests {
         // Overflow checks follow debug assertions: there the panic path itself was exercised.
         if cfg!(debug_assertions) {
             assert!(err.contains("tobj panicked"), "{err}");
+        }
+    }
+
+    /// The scan's per-object forward-reference and colour rules mirror real tobj failures:
+    /// tobj rejects these texts, but without a line; the scan names it.
+    #[test]
+    fn tobj_fails_without_a_line_where_the_scan_names_one() {
+        let cases = [
+            ("o a\nv 0 0 0\nf 1 2 3\no b\nv 1 0 0\nv 0 1 0\n", 3),
+            ("v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 2),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//2 2//2 3//2\ng\nvn 0 1 0\n",
+                5,
+            ),
+        ];
+        for (text, line) in cases {
+            let tobj = run_tobj(Path::new("t.obj"), text).unwrap_err().to_string();
+            assert!(tobj.starts_with("t.obj: tobj rejected the file"), "{tobj}");
+            assert_eq!(
+                scan::scan(text).first_problem.map(|p| p.line),
+                Some(line),
+                "{text:?}"
+            );
         }
     }
 

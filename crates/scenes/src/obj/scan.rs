@@ -7,11 +7,22 @@
 //! and line elements, `l` polylines turned into polygons, non-convex polygons that the fan
 //! triangulation gets wrong, ignored free-form geometry) so the loader can say so in its notes.
 //!
-//! One rule is ours, not tobj's: a line whose first word is not an OBJ statement is rejected
-//! (tobj ignores it). Such a line means a corrupt or truncated file more often than an exotic
-//! exporter.
+//! Some rules are stricter than tobj, because the input they reject means a corrupt, binary or
+//! truncated file more often than an exotic exporter, and a clear error beats a silent guess:
+//! * a line whose first word is not an OBJ statement (tobj ignores it);
+//! * a NUL or other control byte anywhere (binary data), and a carriage return not followed by
+//!   a line feed (classic Mac OS line endings: tobj would read the whole file as one line);
+//! * a `\` line continuation (allowed by the OBJ spec, unsupported by tobj, which fails with
+//!   no line number);
+//! * `v` lines with a colour (`v x y z r g b`) mixed with `v` lines without one (tobj fails,
+//!   without a line, as soon as a face uses an uncoloured vertex).
+//!
+//! tobj resolves positive indices when it closes a model (at an `o`/`g` after faces, and at the
+//! end of the file), so a forward reference must be satisfied by then; the scan checks that at
+//! the same points.
 
 use raybench_geom::DVec3;
+use std::num::IntErrorKind;
 
 /// The first line the scan rejects.
 #[derive(Clone, Debug, PartialEq)]
@@ -83,26 +94,104 @@ struct Totals {
     vn: usize,
 }
 
-/// Scans the whole text; stops collecting at the first problem.
-pub(super) fn scan(text: &str) -> Scan {
-    let totals = count_elements(text);
-    let mut state = State {
-        totals,
-        positions: Vec::new(),
-        vt_so_far: 0,
-        vn_so_far: 0,
-        scan: Scan::default(),
-    };
-    for (i, line) in text.lines().enumerate() {
-        if let Err(problem) = state.line(line) {
-            state.scan.first_problem = Some(LineProblem {
-                line: i + 1,
-                problem,
-            });
-            break;
+/// The kinds of element a face corner refers to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Element {
+    Position,
+    TexCoord,
+    Normal,
+}
+
+impl Element {
+    fn noun(self) -> &'static str {
+        match self {
+            Element::Position => "vertex",
+            Element::TexCoord => "texture-coordinate",
+            Element::Normal => "normal",
         }
     }
+
+    fn keyword(self) -> &'static str {
+        match self {
+            Element::Position => "v",
+            Element::TexCoord => "vt",
+            Element::Normal => "vn",
+        }
+    }
+}
+
+/// A positive index beyond the elements seen so far on its line: tobj resolves it when it
+/// closes the model, so it must be satisfied by then.
+#[derive(Clone, Copy, Debug)]
+struct ForwardRef {
+    line: usize,
+    element: Element,
+    /// 1-based, as written.
+    index: usize,
+}
+
+/// Whether the `v` lines so far carry a colour, and where that was first seen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Colours {
+    Unknown,
+    With { first_line: usize },
+    Without { first_line: usize },
+}
+
+/// Scans the whole text; stops collecting at the first problem.
+pub(super) fn scan(text: &str) -> Scan {
+    if let Some(problem) = binary_or_lone_cr(text) {
+        return Scan {
+            first_problem: Some(problem),
+            ..Scan::default()
+        };
+    }
+    let mut state = State::new(count_elements(text));
+    let mut last_line = 0;
+    for (i, line) in text.lines().enumerate() {
+        state.line_number = i + 1;
+        last_line = i + 1;
+        if let Err(problem) = state.line(line) {
+            state.scan.first_problem = Some(problem);
+            return state.scan;
+        }
+    }
+    // tobj closes the last model at the end of the file.
+    if let Err(problem) = state.close_model(last_line) {
+        state.scan.first_problem = Some(problem);
+    }
     state.scan
+}
+
+/// The first NUL or other control character (binary data), or the first carriage return not
+/// followed by a line feed, with its line and column (in characters).
+fn binary_or_lone_cr(text: &str) -> Option<LineProblem> {
+    let is_binary = |c: char| c.is_control() && !matches!(c, '\t' | '\n' | '\r' | '\x0b' | '\x0c');
+    let mut chars = text.chars().peekable();
+    let (mut line, mut column) = (1, 0);
+    while let Some(c) = chars.next() {
+        column += 1;
+        let problem = if c == '\r' && chars.peek() != Some(&'\n') {
+            "carriage return without a line feed (classic Mac OS line endings?): save the file \
+             with \\n or \\r\\n line endings"
+                .to_owned()
+        } else if is_binary(c) {
+            format!(
+                "control character {} (binary data, not OBJ text)",
+                c.escape_unicode()
+            )
+        } else {
+            if c == '\n' {
+                (line, column) = (line + 1, 0);
+            }
+            continue;
+        };
+        return Some(LineProblem {
+            line,
+            problem: format!("column {column}: {problem}"),
+        });
+    }
+    None
 }
 
 fn count_elements(text: &str) -> Totals {
@@ -120,27 +209,61 @@ fn count_elements(text: &str) -> Totals {
 
 struct State {
     totals: Totals,
+    /// The line being scanned (1-based).
+    line_number: usize,
     /// Positions seen so far (tobj resolves negative indices against these counts).
     positions: Vec<DVec3>,
     vt_so_far: usize,
     vn_so_far: usize,
+    colours: Colours,
+    /// An `f` or `l` since tobj last closed a model (an `o`/`g` closes one only then).
+    model_has_faces: bool,
+    /// Forward references of the open model, per [`Element`] (see `remember_forward`).
+    forward: [Vec<ForwardRef>; 3],
     scan: Scan,
 }
 
 impl State {
-    fn line(&mut self, line: &str) -> Result<(), String> {
+    fn new(totals: Totals) -> State {
+        State {
+            totals,
+            line_number: 0,
+            positions: Vec::new(),
+            vt_so_far: 0,
+            vn_so_far: 0,
+            colours: Colours::Unknown,
+            model_has_faces: false,
+            forward: Default::default(),
+            scan: Scan::default(),
+        }
+    }
+
+    fn line(&mut self, line: &str) -> Result<(), LineProblem> {
+        let at = self.line_number;
+        if matches!(line.split_whitespace().next(), Some("o" | "g")) {
+            self.close_model(at)?;
+        }
+        self.statement(line)
+            .map_err(|problem| LineProblem { line: at, problem })
+    }
+
+    fn statement(&mut self, line: &str) -> Result<(), String> {
         let mut words = line.split_whitespace();
         let Some(keyword) = words.next() else {
             return Ok(());
         };
+        if keyword.starts_with('#') {
+            return Ok(());
+        }
         let args: Vec<&str> = words.collect();
+        if line.trim_end().ends_with('\\') {
+            return Err(
+                "line continuation (`\\` at the end of the line) is not supported: join the lines"
+                    .into(),
+            );
+        }
         match keyword {
-            k if k.starts_with('#') => {}
-            "v" => {
-                let p = parse_position(&args)?;
-                self.positions.push(p);
-                self.scan.vertices += 1;
-            }
+            "v" => self.vertex(&args)?,
             "vt" => {
                 parse_floats(&args, 2, "`vt` needs 2 numbers")?;
                 self.vt_so_far += 1;
@@ -174,6 +297,88 @@ impl State {
         Ok(())
     }
 
+    fn vertex(&mut self, args: &[&str]) -> Result<(), String> {
+        let p = parse_position(args)?;
+        self.check_colour_consistency(args.len() == 6)?;
+        self.positions.push(p);
+        self.scan.vertices += 1;
+        Ok(())
+    }
+
+    /// tobj keeps one colour list for all `v` lines and fails, without a line number, when a
+    /// face uses a vertex past its end: all `v` lines carry a colour or none does.
+    fn check_colour_consistency(&mut self, coloured: bool) -> Result<(), String> {
+        match (self.colours, coloured) {
+            (Colours::Unknown, true) => {
+                self.colours = Colours::With {
+                    first_line: self.line_number,
+                }
+            }
+            (Colours::Unknown, false) => {
+                self.colours = Colours::Without {
+                    first_line: self.line_number,
+                }
+            }
+            (Colours::With { first_line }, false) => {
+                return Err(format!(
+                    "`v` without a colour, but the `v` on line {first_line} has one (r g b): \
+                     give every `v` a colour or none"
+                ));
+            }
+            (Colours::Without { first_line }, true) => {
+                return Err(format!(
+                    "`v` with a colour (r g b), but the `v` on line {first_line} has none: \
+                     give every `v` a colour or none"
+                ));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// tobj closes the open model here if it has faces: every forward reference made in it
+    /// must now be satisfied. `Err` carries the line of the first unsatisfied face.
+    fn close_model(&mut self, at_line: usize) -> Result<(), LineProblem> {
+        if !self.model_has_faces {
+            return Ok(());
+        }
+        self.model_has_faces = false;
+        let refs = std::mem::take(&mut self.forward);
+        let first_unsatisfied = refs
+            .iter()
+            .filter_map(|list| list.iter().find(|r| !self.satisfied(r)))
+            .min_by_key(|r| r.line);
+        match first_unsatisfied {
+            None => Ok(()),
+            Some(r) => Err(LineProblem {
+                line: r.line,
+                problem: format!(
+                    "{} index {} refers forward, but only {} `{}` lines come before its object \
+                     ends at line {at_line} (tobj resolves indices per object)",
+                    r.element.noun(),
+                    r.index,
+                    self.count(r.element),
+                    r.element.keyword()
+                ),
+            }),
+        }
+    }
+
+    fn count(&self, element: Element) -> usize {
+        match element {
+            Element::Position => self.positions.len(),
+            Element::TexCoord => self.vt_so_far,
+            Element::Normal => self.vn_so_far,
+        }
+    }
+
+    /// tobj ignores texture-coordinate and normal indices when a model closes before any
+    /// `vt`/`vn` exists.
+    fn satisfied(&self, r: &ForwardRef) -> bool {
+        let have = self.count(r.element);
+        r.index <= have || (r.element != Element::Position && have == 0)
+    }
+
     fn face(&mut self, args: &[&str]) -> Result<(), String> {
         let corners = self.corners(args)?;
         match corners.len() {
@@ -188,6 +393,7 @@ impl State {
                 }
             }
         }
+        self.model_has_faces = true;
         Ok(())
     }
 
@@ -201,54 +407,57 @@ impl State {
                 self.scan.polylines_as_polygons += 1;
             }
         }
+        self.model_has_faces = true;
         Ok(())
     }
 
     /// The position index (0-based) of every corner of an `f` or `l` statement, checked the way
     /// tobj checks `v`, `vt` and `vn` indices.
-    fn corners(&self, args: &[&str]) -> Result<Vec<usize>, String> {
+    fn corners(&mut self, args: &[&str]) -> Result<Vec<usize>, String> {
         args.iter().map(|token| self.corner(token)).collect()
     }
 
-    fn corner(&self, token: &str) -> Result<usize, String> {
-        let parts: Vec<&str> = token.split('/').collect();
-        if parts.len() > 3 {
-            return Err(format!(
-                "`{}` has more than 3 slash-separated parts",
-                shorten(token)
-            ));
-        }
-        let mut numbers = [None; 3];
-        for (slot, part) in numbers.iter_mut().zip(&parts) {
-            if !part.is_empty() {
-                let n = part.parse::<i64>().map_err(|_| {
-                    let whole = if parts.len() > 1 {
-                        format!(" in `{}`", shorten(token))
-                    } else {
-                        String::new()
-                    };
-                    format!("`{}`{whole} is not an integer index", shorten(part))
-                })?;
-                *slot = Some(n);
-            }
-        }
-        let [v, vt, vn] = numbers;
+    fn corner(&mut self, token: &str) -> Result<usize, String> {
+        let [v, vt, vn] = parse_corner(token)?;
         let v = v.ok_or_else(|| format!("`{}` has no vertex index", shorten(token)))?;
-        let position = resolve(v, self.positions.len(), self.totals.v, "vertex", "v")?;
+        let position = self.resolve(v, Element::Position)?;
         // tobj reads `vt`/`vn` indices only when the file has any `vt`/`vn`, and treats 0 as absent.
         if let Some(vt) = vt.filter(|&i| i != 0 && self.totals.vt > 0) {
-            resolve(
-                vt,
-                self.vt_so_far,
-                self.totals.vt,
-                "texture-coordinate",
-                "vt",
-            )?;
+            self.resolve(vt, Element::TexCoord)?;
         }
         if let Some(vn) = vn.filter(|&i| i != 0 && self.totals.vn > 0) {
-            resolve(vn, self.vn_so_far, self.totals.vn, "normal", "vn")?;
+            self.resolve(vn, Element::Normal)?;
         }
         Ok(position)
+    }
+
+    /// Resolves an index against the whole file, and remembers a forward reference so it can
+    /// be checked when tobj closes the model.
+    fn resolve(&mut self, index: i64, element: Element) -> Result<usize, String> {
+        let total = match element {
+            Element::Position => self.totals.v,
+            Element::TexCoord => self.totals.vt,
+            Element::Normal => self.totals.vn,
+        };
+        let zero_based = resolve(index, self.count(element), total, element)?;
+        if zero_based >= self.count(element) {
+            self.remember_forward(element, zero_based + 1);
+        }
+        Ok(zero_based)
+    }
+
+    /// Keeps only forward references larger than every earlier one of their kind: when a
+    /// smaller later one fails, an earlier one has failed first, so only these can be the first
+    /// failure (and a file made of forward references keeps a short list).
+    fn remember_forward(&mut self, element: Element, index: usize) {
+        let list = &mut self.forward[element as usize];
+        if list.last().is_none_or(|r| index > r.index) {
+            list.push(ForwardRef {
+                line: self.line_number,
+                element,
+                index,
+            });
+        }
     }
 
     fn is_non_convex(&self, corners: &[usize]) -> bool {
@@ -261,15 +470,40 @@ impl State {
     }
 }
 
+/// `v`, `v/vt`, `v//vn` or `v/vt/vn`: up to three optional signed integers.
+fn parse_corner(token: &str) -> Result<[Option<i64>; 3], String> {
+    let parts: Vec<&str> = token.split('/').collect();
+    if parts.len() > 3 {
+        return Err(format!(
+            "`{}` has more than 3 slash-separated parts",
+            shorten(token)
+        ));
+    }
+    let mut numbers = [None; 3];
+    for (slot, part) in numbers.iter_mut().zip(&parts) {
+        if part.is_empty() {
+            continue;
+        }
+        let whole = if parts.len() > 1 {
+            format!(" in `{}`", shorten(token))
+        } else {
+            String::new()
+        };
+        *slot = Some(part.parse::<i64>().map_err(|e| match e.kind() {
+            IntErrorKind::PosOverflow | IntErrorKind::NegOverflow => {
+                format!("index `{}`{whole} is too large", shorten(part))
+            }
+            _ => format!("`{}`{whole} is not an integer index", shorten(part)),
+        })?);
+    }
+    Ok(numbers)
+}
+
 /// Resolves a 1-based or negative (relative) OBJ index to a 0-based one, as tobj does: negative
-/// indices count back from the elements seen so far, positive ones may refer forward.
-fn resolve(
-    index: i64,
-    so_far: usize,
-    total: usize,
-    what: &str,
-    keyword: &str,
-) -> Result<usize, String> {
+/// indices count back from the elements seen so far, positive ones may refer forward (checked
+/// here against the whole file, and by [`State::close_model`] against its object).
+fn resolve(index: i64, so_far: usize, total: usize, element: Element) -> Result<usize, String> {
+    let (what, keyword) = (element.noun(), element.keyword());
     if index == 0 {
         return Err(format!("{what} index 0 (OBJ indices start at 1)"));
     }
@@ -296,7 +530,11 @@ fn parse_position(args: &[&str]) -> Result<DVec3, String> {
     let xyz = parse_floats(args, 3, "`v` needs 3 numbers")?;
     let p = DVec3::new(xyz[0], xyz[1], xyz[2]);
     match args.len() {
-        3 | 6 => Ok(p),
+        3 => Ok(p),
+        6 => {
+            parse_floats(&args[3..], 3, "`v` colour needs 3 numbers (r g b)")?;
+            Ok(p)
+        }
         4 => match args[3].parse::<f32>() {
             Ok(0.0) => Err("`v` with w = 0".into()),
             Ok(w) => Ok(p / f64::from(w)),
@@ -328,13 +566,24 @@ fn rest_after_space(line: &str) -> &str {
     line.split_once(' ').map_or("", |(_, rest)| rest.trim())
 }
 
-/// At most 40 characters of a token, so a huge garbage line does not flood the message.
+/// At most 40 characters of a token, so a huge garbage line does not flood the message, with
+/// invisible characters (zero-width spaces, controls) escaped so the reader sees them.
 fn shorten(s: &str) -> String {
     const MAX: usize = 40;
-    if s.chars().count() <= MAX {
-        s.to_owned()
+    let mut out: String = s.chars().take(MAX).map(visible).collect();
+    if s.chars().nth(MAX).is_some() {
+        out.push('…');
+    }
+    out
+}
+
+/// A character as the reader should see it in a message: printable ASCII and other printable
+/// characters as they are, anything invisible as a `\u{…}` escape.
+fn visible(c: char) -> String {
+    if c.is_ascii_graphic() || (!c.is_ascii() && c.escape_debug().count() == 1) {
+        c.to_string()
     } else {
-        s.chars().take(MAX).collect::<String>() + "…"
+        c.escape_unicode().to_string()
     }
 }
 
@@ -346,14 +595,24 @@ pub(super) fn polygon_is_non_convex(points: &[DVec3]) -> bool {
     if !normal.is_finite() || normal.length_squared() == 0.0 {
         return false;
     }
+    // The corners were rounded to f32: each is only known to a few f32 ulps of the largest
+    // coordinate. A dent smaller than that is rounding, not shape (a finely tessellated disc,
+    // 100k corners on a circle, has such dents everywhere and is convex).
+    let scale = points
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    let position_slack = 4.0 * f64::from(f32::EPSILON) * scale;
     (0..n).any(|i| {
         let a = points[i];
         let b = points[(i + 1) % n];
         let c = points[(i + 2) % n];
         let (e1, e2) = (b - a, c - b);
         let turn = e1.cross(e2).dot(normal);
-        // Relative tolerance: rounding in the cross product, not geometry, below 1e-9.
-        turn < -1e-9 * e1.length() * e2.length() * normal.length()
+        // Moving a corner by `position_slack` changes the cross product by about
+        // slack × (|e1| + |e2|); the relative 1e-9 covers f64 rounding in the product itself.
+        let slack =
+            (position_slack * (e1.length() + e2.length())).max(1e-9 * e1.length() * e2.length());
+        turn < -slack * normal.length()
     })
 }
 
@@ -438,6 +697,92 @@ mod tests {
         let mut reversed = to3(&arrow);
         reversed.reverse();
         assert!(polygon_is_non_convex(&reversed));
+        // A 100k-corner disc rounded to f32 has dents of rounding size only: convex.
+        let n = 100_000;
+        let disc: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                DVec3::new(f64::from(a.cos() as f32), f64::from(a.sin() as f32), 0.0)
+            })
+            .collect();
+        assert!(!polygon_is_non_convex(&disc));
+        // A real dent in a fine polygon is still found: one corner pulled in by 1 %.
+        let mut dented = disc;
+        dented[500] *= 0.99;
+        assert!(polygon_is_non_convex(&dented));
+    }
+
+    #[test]
+    fn forward_references_must_be_satisfied_when_tobj_closes_the_object() {
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        // Satisfied before the object ends: fine, also across a `g` with no faces before it.
+        assert_eq!(problem(&format!("o a\nf 1 2 3\n{tri}o b\n")), None);
+        assert_eq!(problem(&format!("g a\ng b\nf 1 2 3\n{tri}")), None);
+        // Not satisfied by the `o` that ends the object: the face's line is named.
+        let p = problem("v 0 0 0\nf 1 2 3\no next\nv 1 0 0\nv 0 1 0\n").unwrap();
+        assert_eq!(p.line, 2);
+        assert!(
+            p.problem
+                .contains("vertex index 2 refers forward, but only 1 `v`"),
+            "{p:?}"
+        );
+        assert!(p.problem.contains("ends at line 3"), "{p:?}");
+        // The first failing face is named, not the one with the largest index.
+        let p = problem("f 1 2 5\nf 1 2 3\nv 0 0 0\no x\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\n");
+        assert_eq!(p.unwrap().line, 1);
+        // tobj ignores texture indices of an object that closes before any `vt`.
+        assert_eq!(problem(&format!("{tri}f 1/1 2/1 3/1\no x\nvt 0 0\n")), None);
+        let p = problem(&format!("{tri}vt 0 0\nf 1/2 2/2 3/2\no x\nvt 1 1\n")).unwrap();
+        assert!(
+            p.problem
+                .contains("texture-coordinate index 2 refers forward"),
+            "{p:?}"
+        );
+    }
+
+    #[test]
+    fn binary_data_lone_carriage_returns_and_continuations_are_named() {
+        let p = problem("v 0 0 0\nv 1\u{1} 0 0\n").unwrap();
+        assert_eq!(
+            (p.line, p.problem.as_str()),
+            (
+                2,
+                "column 4: control character \\u{1} (binary data, not OBJ text)"
+            )
+        );
+        let p = problem("v 0 0 0\r\nv 1 0 0\rv 0 1 0\r\n").unwrap();
+        assert_eq!(p.line, 2);
+        assert!(
+            p.problem
+                .starts_with("column 8: carriage return without a line feed"),
+            "{p:?}"
+        );
+        for text in ["f 1 2 \\\n3\n", "f 1 2\\\n3\n", "v 0 0 \\"] {
+            let p = problem(text).unwrap();
+            assert!(
+                p.problem.starts_with("line continuation"),
+                "{text:?}: {p:?}"
+            );
+        }
+        // A backslash inside a comment or a name is not a continuation.
+        assert_eq!(problem("# C:\\models\\\no a\\b\n"), None);
+    }
+
+    #[test]
+    fn vertex_colours_are_all_or_none() {
+        assert_eq!(problem("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\n"), None);
+        let p = problem("v 0 0 0\nv 1 0 0 0 1 0\n").unwrap();
+        assert_eq!(p.line, 2);
+        assert!(p.problem.contains("the `v` on line 1 has none"), "{p:?}");
+    }
+
+    #[test]
+    fn huge_indices_and_invisible_characters_are_said_plainly() {
+        let p = problem("v 0 0 0\nf 1 1 -99999999999999999999\n").unwrap();
+        assert_eq!(p.problem, "index `-99999999999999999999` is too large");
+        let p = problem("v 0 0 0\nf 1 1 1\u{200b}\n").unwrap();
+        assert_eq!(p.problem, "`1\\u{200b}` is not an integer index");
+        assert_eq!(shorten(&"é".repeat(50)), "é".repeat(40) + "…");
     }
 
     #[test]
