@@ -8,6 +8,7 @@
 
 mod brute;
 pub mod compare;
+pub mod compare_points;
 mod counters;
 mod mailbox;
 mod nearest;
@@ -138,6 +139,21 @@ pub trait Accel: Send + Sync {
     /// point–triangle distance tests (in `prim_tests`).
     fn closest_point_counted(&self, p: Vec3, max_radius: f32, c: &mut Counters)
     -> Option<PointHit>;
+
+    /// Answers `points[first..first + out.len()]` (closest point within `max_radius`): the
+    /// timed batch path. One dynamic call per batch, then this structure's own `closest_point`
+    /// (statically dispatched), as rays pay through [`Accel::intersect_prepared`].
+    fn closest_points(
+        &self,
+        points: &[Vec3],
+        max_radius: f32,
+        first: usize,
+        out: &mut [Option<PointHit>],
+    ) {
+        for (o, &p) in out.iter_mut().zip(&points[first..]) {
+            *o = self.closest_point(p, max_radius);
+        }
+    }
 
     fn build_stats(&self) -> BuildStats;
     fn memory(&self) -> Memory;

@@ -14,7 +14,7 @@
 //! Entries in the base that the new report lacks fail too (a structure that stopped building is
 //! not "no regression"); entries only in the new report are listed as new.
 
-use crate::report::{Report, ResultEntry, WorkloadResult};
+use crate::report::{Report, ResultEntry, WorkloadResult, is_point_workload, throughput_unit};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -122,7 +122,9 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
             };
             let label = format!("{} / {} / {}", key.0, key.1, bw.workload);
             let is_reference = key.1 == new.run.reference;
-            let independent_rays = matches!(bw.workload.as_str(), "primary" | "random");
+            // Query points, like primary and random rays, depend on the scene and seed only.
+            let independent_rays =
+                matches!(bw.workload.as_str(), "primary" | "random") || bw.point_query;
             let gate_counters = comparable && (same_embree || independent_rays);
             compare_workload(
                 &label,
@@ -177,13 +179,16 @@ fn environment_warnings(base: &Report, new: &Report, findings: &mut Vec<Finding>
         }
     }
     let (br, nr) = (&base.run, &new.run);
-    let settings = [
+    let mut settings = vec![
         ("seed", br.seed.to_string(), nr.seed.to_string()),
         ("rays", br.rays.to_string(), nr.rays.to_string()),
         ("reference", br.reference.clone(), nr.reference.clone()),
-        ("workloads", br.workloads.join(","), nr.workloads.join(",")),
     ];
-    let mut comparable = true;
+    // A base without point workloads says nothing about the point count.
+    if ran_points(base) {
+        settings.push(("points", br.points.to_string(), nr.points.to_string()));
+    }
+    let mut comparable = workloads_comparable(&br.workloads, &nr.workloads, findings);
     for (what, b, n) in settings {
         if b != n {
             comparable = false;
@@ -197,6 +202,45 @@ fn environment_warnings(base: &Report, new: &Report, findings: &mut Vec<Finding>
         }
     }
     comparable
+}
+
+fn ran_points(report: &Report) -> bool {
+    report.run.workloads.iter().any(|w| is_point_workload(w))
+}
+
+/// A workload the base ran and the new report lacks makes the figures incomparable (as any
+/// other changed setting); workloads only the new report has are new, not a regression (so a
+/// baseline from before point workloads still gates the ray workloads it has).
+fn workloads_comparable(base: &[String], new: &[String], findings: &mut Vec<Finding>) -> bool {
+    let dropped: Vec<&str> = base
+        .iter()
+        .filter(|w| !new.contains(w))
+        .map(String::as_str)
+        .collect();
+    let added: Vec<&str> = new
+        .iter()
+        .filter(|w| !base.contains(w))
+        .map(String::as_str)
+        .collect();
+    if !added.is_empty() {
+        findings.push(Finding {
+            severity: Severity::Note,
+            what: format!("new workloads (no baseline): {}", added.join(",")),
+        });
+    }
+    if dropped.is_empty() {
+        return true;
+    }
+    findings.push(Finding {
+        severity: Severity::Regression,
+        what: format!(
+            "different run settings (workloads: base `{}`, new `{}`): deterministic figures \
+             cannot be compared; regenerate the baseline with the same settings",
+            base.join(","),
+            new.join(",")
+        ),
+    });
+    false
 }
 
 fn compare_build_stats(b: &ResultEntry, n: &ResultEntry, findings: &mut Vec<Finding>) {
@@ -292,7 +336,7 @@ fn compare_workload(
         && !is_reference
     {
         timing_finding(
-            &format!("{label}: Mrays/s ratio"),
+            &format!("{label}: {} ratio", throughput_unit(&b.workload)),
             x,
             y,
             x / y - 1.0,
@@ -306,8 +350,13 @@ fn counters_text(w: &WorkloadResult) -> String {
     match &w.counters_per_ray {
         None => "none".into(),
         Some(c) => format!(
-            "nodes {:.3}, leaves {:.3}, prim tests {:.3}, cells {:.3}, mailbox skips {:.3} per ray",
-            c.nodes, c.leaves, c.prim_tests, c.cells, c.mailbox_skips
+            "nodes {:.3}, leaves {:.3}, prim tests {:.3}, cells {:.3}, mailbox skips {:.3} per {}",
+            c.nodes,
+            c.leaves,
+            c.prim_tests,
+            c.cells,
+            c.mailbox_skips,
+            if w.point_query { "query" } else { "ray" }
         ),
     }
 }

@@ -1,10 +1,11 @@
 //! `raybench`: list what can be measured, run measurements into a validated JSON report, and
 //! look at scenes (`raybench scene list|export|preview`).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
+use raybench_harness::cli;
 use raybench_harness::registry;
-use raybench_harness::run::{RunOptions, SceneRequest, run, suite_requests};
+use raybench_harness::run::{RunOptions, run};
 use raybench_harness::scene_cmd;
 use raybench_harness::summary::summary_table;
 use raybench_scenes::Workload;
@@ -37,6 +38,16 @@ enum Command {
     /// Compare two reports: a Markdown table of changes; exit 2 on a regression (a mismatch
     /// rose, a deterministic figure changed, a timing ratio worsened beyond --max-slowdown).
     Compare(CompareArgs),
+    /// Check answers, not speed: every structure (default: all registered) × scene × workload
+    /// against embree-medium, embree-robust and brute force; write DIR/verify.json. Exit 0
+    /// with no mismatch, 2 on any mismatch, 1 on errors.
+    Verify(cli::VerifyArgs),
+    /// Trace one ray (bit patterns from a report or from `verify`) through every structure,
+    /// the references and a double-precision test over every triangle.
+    Replay(cli::ReplayArgs),
+    /// Crack hunting: miss rates of rays aimed at the edges and vertices of closed meshes near
+    /// and far from the origin, next to Embree's bar for robust mode (2e-5).
+    Watertight(cli::WatertightArgs),
 }
 
 #[derive(Args, Debug)]
@@ -106,48 +117,44 @@ struct PreviewArgs {
 
 #[derive(Args, Debug)]
 struct RunArgs {
-    /// A suite from bench-scenes/ (see `raybench list`); flags below override its settings.
-    #[arg(long)]
-    suite: Option<String>,
-    /// Scene specs (sphere, soup:triangles=5000) or .obj paths, comma-separated.
-    #[arg(long, value_delimiter = ',')]
-    scenes: Vec<String>,
-    /// Structures, comma-separated (default: the suite's, or every registered one).
-    #[arg(long, value_delimiter = ',')]
-    structures: Vec<String>,
-    /// Workloads, comma-separated: primary, random, shadow, diffuse.
-    #[arg(long, value_delimiter = ',')]
-    workloads: Vec<Workload>,
-    /// Rays per workload (primary: the image closest to this many pixels at 4:3).
-    #[arg(long)]
-    rays: Option<usize>,
-    /// Worker threads for builds and traces (Embree gets threads=N).
-    #[arg(long, default_value_t = 1)]
-    threads: usize,
+    /// Structures default to the suite's, or to every registered one.
+    #[command(flatten)]
+    selection: cli::Selection,
     /// The structure every answer is checked against and every ratio is relative to.
     #[arg(long, default_value = "embree-medium")]
     reference: String,
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
     /// Timed builds after one warm-up build.
     #[arg(long, default_value_t = 3)]
     build_runs: usize,
     /// Timed trace passes after one warm-up pass.
     #[arg(long, default_value_t = 5)]
     trace_runs: usize,
-    /// Enable flush-to-zero and denormals-are-zero on every worker (Embree and native alike).
-    #[arg(long)]
-    ftz_daz: bool,
     /// Output directory (default: reports/<date>-<revision>).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Leave the per-pixel pictures of primary rays out of the report (smaller; for baselines).
     #[arg(long)]
     no_images: bool,
+    /// Write every ray and each structure's answer here (see README, "Hit dumps").
+    #[arg(long)]
+    dump_hits: Option<PathBuf>,
 }
 
 fn main() -> ExitCode {
-    match real_main() {
+    one_line_panics();
+    // Usage errors exit 1 like every other error: 2 means "mismatch" to scripts.
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
+    match real_main(cli) {
         Ok(code) => code,
         // `raybench list | head`: the reader left; nothing went wrong.
         Err(e)
@@ -165,8 +172,24 @@ fn main() -> ExitCode {
     }
 }
 
-fn real_main() -> Result<ExitCode> {
-    match Cli::parse().command {
+/// A panic (a bug) prints one line naming where it happened instead of a backtrace prompt;
+/// the harness catches panics per structure and records them as errors in the report.
+fn one_line_panics() {
+    std::panic::set_hook(Box::new(|info| {
+        let msg = raybench_harness::run::panic_message(info.payload());
+        let at = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        eprintln!("raybench: internal error{at}: {msg}");
+    }));
+}
+
+fn real_main(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Verify(args) => cli::verify_command(args),
+        Command::Replay(args) => cli::replay_command(args),
+        Command::Watertight(args) => cli::watertight_command(args),
         Command::List => list().map(|_| ExitCode::SUCCESS),
         Command::Run(args) => run_command(args),
         Command::Scene(cmd) => scene_command(cmd).map(|_| ExitCode::SUCCESS),
@@ -298,164 +321,65 @@ fn list() -> Result<()> {
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default();
         println!(
-            "  {stem:<24} {} ({} scenes, {} rays)",
+            "  {stem:<24} {} ({} scenes, {} rays{})",
             suite.description,
             suite.scenes.len(),
-            suite.rays
+            suite.rays,
+            suite
+                .points
+                .map(|p| format!(", {p} points"))
+                .unwrap_or_default()
         );
     }
     Ok(())
 }
 
-fn default_out_dir() -> PathBuf {
-    let date = &raybench_harness::env::utc_timestamp()[..10];
-    let rev: String = raybench_harness::env::git_revision()
-        .chars()
-        .take(10)
-        .collect();
-    PathBuf::from("reports").join(format!("{date}-{rev}"))
-}
-
 fn run_command(args: RunArgs) -> Result<ExitCode> {
-    let (suite, requests) = match &args.suite {
-        Some(name) => {
-            let path = raybench_scenes::suites_dir().join(format!("{name}.json"));
-            let suite =
-                raybench_scenes::load_suite(&path).with_context(|| format!("suite '{name}'"))?;
-            let requests = if args.scenes.is_empty() {
-                suite_requests(&path, &suite.scenes)
-            } else {
-                specs(&args.scenes)
-            };
-            (Some(suite), requests)
-        }
-        None => {
-            anyhow::ensure!(
-                !args.scenes.is_empty(),
-                "give --suite NAME or --scenes A,B (see `raybench list`)"
-            );
-            (None, specs(&args.scenes))
-        }
+    let defaults = cli::Defaults {
+        structures: cli::all_structures(),
+        rays: 100_000,
+        points: cli::DEFAULT_POINTS,
     };
-    let all_structures = || {
-        registry::registry()
-            .iter()
-            .map(|e| e.name.to_string())
-            .collect::<Vec<_>>()
-    };
+    let r = args.selection.resolve(true, defaults)?;
+    registry::find(&args.reference)?;
+    let dir = args.out.unwrap_or_else(cli::default_out_dir);
+    cli::check_outputs(&dir, args.dump_hits.as_deref())?;
+    let sel = &args.selection;
     let opts = RunOptions {
-        suite: args.suite.clone(),
-        scenes: requests.iter().map(|r| format!("{r:?}")).collect(),
-        structures: pick(
-            args.structures,
-            suite.as_ref().map(|s| s.structures.clone()),
-            all_structures,
-        ),
-        workloads: pick(
-            args.workloads,
-            suite.as_ref().map(|s| s.workloads.clone()),
-            || Workload::ALL.to_vec(),
-        ),
-        rays: args
-            .rays
-            .or(suite.as_ref().map(|s| s.rays))
-            .unwrap_or(100_000),
-        threads: args.threads,
+        suite: sel.suite.clone(),
+        scenes: r.requests.iter().map(|r| format!("{r:?}")).collect(),
+        structures: r.structures,
+        workloads: r.workloads,
+        rays: r.rays,
+        points: r.points,
+        threads: sel.threads,
         reference: args.reference,
-        seed: args.seed,
+        seed: sel.seed,
         build_runs: args.build_runs,
         trace_runs: args.trace_runs,
-        ftz_daz: args.ftz_daz,
+        ftz_daz: sel.ftz_daz,
         progress: std::io::stdout().is_terminal(),
         images: !args.no_images,
+        dump_hits: args.dump_hits.clone(),
     };
-    let report = run(&opts, &requests)?;
-    let dir = args.out.unwrap_or_else(default_out_dir);
+    let report = run(&opts, &r.requests)?;
     let path = report.write_atomic(&dir)?;
     print!("{}", summary_table(&report));
     println!("report: {}", path.display());
+    if let Some(d) = &args.dump_hits {
+        println!("hit dumps: {}", d.display());
+    }
     // The report is safe on disk first: a drawing failure is reported, never loses it.
     match raybench_harness::render::render(&report, &dir) {
         Ok(r) => print_rendered(&r),
         Err(e) => eprintln!("raybench: drawing the report failed: {e:#}"),
     }
-    Ok(if report.mismatches() > 0 {
+    if report.mismatches() > 0 {
         eprintln!(
             "raybench: {} mismatches against {}",
             report.mismatches(),
             report.run.reference
         );
-        ExitCode::from(2)
-    } else if !report.errors.is_empty() {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
-    })
-}
-
-fn specs(scenes: &[String]) -> Vec<SceneRequest> {
-    join_spec_parameters(scenes)
-        .into_iter()
-        .map(SceneRequest::Spec)
-        .collect()
-}
-
-/// `--scenes` is split on commas, and so are a spec's parameters: `offset:triangles=500,offset=1e7`
-/// arrives as `offset:triangles=500` and `offset=1e7`. A piece that is `key=value` (it has `=`
-/// but no `:` and is not an `.obj` path) continues the spec before it.
-fn join_spec_parameters(pieces: &[String]) -> Vec<String> {
-    let mut specs: Vec<String> = Vec::new();
-    for piece in pieces {
-        let continues = piece.contains('=')
-            && !piece.contains(':')
-            && !piece.to_ascii_lowercase().ends_with(".obj");
-        match specs.last_mut() {
-            Some(last) if continues => {
-                last.push(',');
-                last.push_str(piece);
-            }
-            _ => specs.push(piece.clone()),
-        }
     }
-    specs
-}
-
-/// Explicit flags win, then the suite's value, then the default.
-fn pick<T>(
-    explicit: Vec<T>,
-    from_suite: Option<Vec<T>>,
-    default: impl FnOnce() -> Vec<T>,
-) -> Vec<T> {
-    if !explicit.is_empty() {
-        explicit
-    } else {
-        from_suite.unwrap_or_else(default)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::join_spec_parameters;
-
-    #[test]
-    fn parameters_rejoin_their_spec() {
-        let pieces: Vec<String> = [
-            "offset:triangles=500",
-            "offset=1e7",
-            "sphere",
-            "soup:triangles=5",
-            "a/b=c.obj",
-        ]
-        .map(String::from)
-        .to_vec();
-        assert_eq!(
-            join_spec_parameters(&pieces),
-            [
-                "offset:triangles=500,offset=1e7",
-                "sphere",
-                "soup:triangles=5",
-                "a/b=c.obj"
-            ]
-        );
-    }
+    Ok(cli::exit_status(report.mismatches(), report.errors.len()))
 }

@@ -1,18 +1,20 @@
-//! Timing: builds and trace passes, medians of repeated runs after a warm-up.
+//! Timing: builds, trace passes and closest-point passes, medians of repeated runs after a
+//! warm-up.
 //!
 //! Nothing here counts or checks inside a timed region: the trace passes call the structures'
-//! prepared batch path (rays already in each structure's layout), and the counting pass is a
-//! separate, untimed, single-threaded walk.
+//! prepared batch path (rays already in each structure's layout), the point passes their batch
+//! closest-point path ([`Accel::closest_points`]), both over the same rayon chunks, and the
+//! counting passes are separate, untimed, single-threaded walks.
 
 use crate::registry::{BuildContext, Built, StructureEntry};
 use crate::report::{Throughput, Timing};
-use raybench_accel::{Accel, BuildError, Counters, Hit, PreparedRays};
-use raybench_geom::{Ray, TriangleMesh};
+use raybench_accel::{Accel, BuildError, Counters, Hit, PointHit, PreparedRays};
+use raybench_geom::{Ray, TriangleMesh, Vec3};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Rays per rayon task when tracing with several threads: large enough that scheduling costs
+/// Rays (or query points) per rayon task when tracing with several threads: large enough that scheduling costs
 /// are noise (~1 µs per task vs ≥ 25 µs of tracing), small enough to balance 2 cores.
 const CHUNK: usize = 256;
 
@@ -91,6 +93,14 @@ impl Answers {
         self.len() == 0
     }
 
+    /// The answers at `indices` (a subsample), in that order.
+    pub fn gather(&self, indices: &[usize]) -> Answers {
+        match self {
+            Answers::Closest(h) => Answers::Closest(indices.iter().map(|&i| h[i]).collect()),
+            Answers::Any(o) => Answers::Any(indices.iter().map(|&i| o[i]).collect()),
+        }
+    }
+
     pub fn closest(&self) -> Option<&[Option<Hit>]> {
         match self {
             Answers::Closest(h) => Some(h),
@@ -135,27 +145,85 @@ pub fn time_traces(
 ) -> (Answers, Throughput) {
     let mut answers = Answers::new(any_hit, rays.len());
     let warm = trace_pass(accel, rays, prepared, threads, &mut answers);
-    let runs = if warm > LONG_PASS { 1 } else { runs.max(1) };
     let mut scratch = Answers::new(any_hit, rays.len());
-    let mrays: Vec<f64> = (0..runs)
-        .map(|_| {
-            rays.len() as f64
-                / trace_pass(accel, rays, prepared, threads, &mut scratch)
-                    .as_secs_f64()
-                    .max(1e-9)
-                / 1e6
-        })
+    let throughput = time_passes(rays.len(), warm, runs, || {
+        trace_pass(accel, rays, prepared, threads, &mut scratch)
+    });
+    (answers, throughput)
+}
+
+/// Millions of queries per second over `runs` timed passes (one when the warm-up took longer
+/// than [`LONG_PASS`]): median, minimum and maximum.
+fn time_passes(
+    queries: usize,
+    warm_up: Duration,
+    runs: usize,
+    mut pass: impl FnMut() -> Duration,
+) -> Throughput {
+    let runs = if warm_up > LONG_PASS { 1 } else { runs.max(1) };
+    let per_pass: Vec<f64> = (0..runs)
+        .map(|_| queries as f64 / pass().as_secs_f64().max(1e-9) / 1e6)
         .collect();
-    let (median, min, max) = median_min_max(&mrays);
-    (
-        answers,
-        Throughput {
-            median,
-            min,
-            max,
-            runs,
-        },
-    )
+    let (median, min, max) = median_min_max(&per_pass);
+    Throughput {
+        median,
+        min,
+        max,
+        runs,
+    }
+}
+
+/// One closest-point pass over every point through the structure's batch path, like
+/// [`trace_pass`]: a plain loop with one thread, rayon chunks of [`CHUNK`] points otherwise.
+pub fn point_pass(
+    accel: &dyn Accel,
+    points: &[Vec3],
+    radius: f32,
+    threads: usize,
+    out: &mut [Option<PointHit>],
+) -> Duration {
+    let start = Instant::now();
+    if threads <= 1 {
+        accel.closest_points(points, radius, 0, out);
+    } else {
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(i, chunk)| accel.closest_points(points, radius, i * CHUNK, chunk));
+    }
+    start.elapsed()
+}
+
+/// A warm-up closest-point pass (whose answers are returned for validation), then timed
+/// passes: the method of [`time_traces`]. Throughput is in millions of queries per second.
+pub fn time_point_queries(
+    accel: &dyn Accel,
+    points: &[Vec3],
+    radius: f32,
+    threads: usize,
+    runs: usize,
+) -> (Vec<Option<PointHit>>, Throughput) {
+    let mut answers = vec![None; points.len()];
+    let warm = point_pass(accel, points, radius, threads, &mut answers);
+    let mut scratch = vec![None; points.len()];
+    let throughput = time_passes(points.len(), warm, runs, || {
+        point_pass(accel, points, radius, threads, &mut scratch)
+    });
+    (answers, throughput)
+}
+
+/// The untimed counted closest-point walk over every point, single-threaded so the counters
+/// are exact (`prim_tests` counts point–triangle distance tests).
+pub fn count_point_pass(
+    accel: &dyn Accel,
+    points: &[Vec3],
+    radius: f32,
+) -> (Vec<Option<PointHit>>, Counters) {
+    let mut c = Counters::default();
+    let answers = points
+        .iter()
+        .map(|&p| accel.closest_point_counted(p, radius, &mut c))
+        .collect();
+    (answers, c)
 }
 
 /// The untimed counting walk, single-threaded so the counters are deterministic.

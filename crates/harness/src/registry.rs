@@ -56,6 +56,12 @@ impl StructureEntry {
     pub fn build(&self, mesh: Arc<TriangleMesh>, ctx: &BuildContext) -> Result<Built, BuildError> {
         (self.builder)(mesh, ctx)
     }
+
+    /// Brute force: every ray tests every triangle, so its cost per ray grows with the scene
+    /// and `verify` traces it on a budgeted subsample only.
+    pub fn is_exhaustive(&self) -> bool {
+        self.suite_triangle_limit == Some(BRUTE_FORCE_SUITE_LIMIT)
+    }
 }
 
 fn register<A: Accel + 'static>(

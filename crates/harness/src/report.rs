@@ -6,8 +6,8 @@
 
 use crate::env::Environment;
 use raybench_accel::compare::{Tolerance, VerdictCounts};
-use raybench_accel::{BuildStats, Counters, Hit, Memory};
-use raybench_geom::{Ray, RemovedTriangles};
+use raybench_accel::{BuildStats, Counters, Hit, Memory, PointHit};
+use raybench_geom::{Ray, RemovedTriangles, Vec3};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -34,6 +34,9 @@ pub struct RunSettings {
     pub suite: Option<String>,
     pub seed: u64,
     pub rays: usize,
+    /// Query points per closest-point workload (0 in reports older than point workloads).
+    #[serde(default)]
+    pub points: usize,
     pub threads: usize,
     pub reference: String,
     pub build_runs: usize,
@@ -60,8 +63,12 @@ pub struct SceneRecord {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WorkloadRecord {
     pub workload: String,
+    /// Queries: rays, or query points for a point workload.
     pub rays: usize,
     pub any_hit: bool,
+    /// A closest-point workload (`points-near`, `points-volume`), asked with an infinite radius.
+    #[serde(default)]
+    pub point_query: bool,
     /// Primary image size, where the workload is an image.
     pub width: Option<u32>,
     pub height: Option<u32>,
@@ -113,11 +120,20 @@ pub struct Throughput {
     pub runs: usize,
 }
 
+/// One structure on one workload. For a closest-point workload (`point_query`), `rays` counts
+/// query points, `mrays_per_s` is millions of queries per second, `counters_per_ray` is per
+/// query (`prim_tests` = point–triangle distance tests) and the validation classes count
+/// queries (`both_miss` = neither found a triangle).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WorkloadResult {
     pub workload: String,
+    /// Queries: rays, or query points for a point workload.
     pub rays: usize,
     pub any_hit: bool,
+    /// True for a closest-point workload (absent in older reports: false).
+    #[serde(default)]
+    pub point_query: bool,
+    /// Millions of queries per second: rays, or closest-point queries when `point_query`.
     pub mrays_per_s: Throughput,
     /// Median throughput divided by the reference's in this run (> 1: faster than reference).
     pub speedup_vs_reference: Option<f64>,
@@ -163,6 +179,9 @@ pub struct Validation {
     pub first_mismatches: Vec<DisputedRay>,
     /// First few explained disagreements (boundary, edge-ambiguous), for replay.
     pub first_ambiguous: Vec<DisputedRay>,
+    /// Point workloads: the first mismatched queries, with the point's bits for replay.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub first_point_mismatches: Vec<DisputedPoint>,
 }
 
 impl Validation {
@@ -180,6 +199,7 @@ impl Validation {
             mismatch_rate_upper95: upper95,
             first_mismatches: Vec::new(),
             first_ambiguous: Vec::new(),
+            first_point_mismatches: Vec::new(),
         }
     }
 
@@ -257,24 +277,66 @@ impl DisputedRay {
     }
 }
 
+/// A closest-point query two answers disagree on, with the bits to replay it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DisputedPoint {
+    pub index: usize,
+    pub verdict: String,
+    /// x, y, z as hex f32 bit patterns.
+    pub point_bits: Vec<String>,
+    pub point: [f32; 3],
+    /// The search radius; `null` is infinite (the workloads' radius).
+    pub radius: Option<f32>,
+    /// `null`: no triangle within the radius.
+    pub ours: Option<PointRecord>,
+    pub reference: Option<PointRecord>,
+}
+
+/// A closest-point answer: the triangle, the nearest point on it and the distance (with bits).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointRecord {
+    pub prim: u32,
+    pub point: [f32; 3],
+    pub distance: f32,
+    pub distance_bits: String,
+}
+
+impl DisputedPoint {
+    pub fn new(
+        index: usize,
+        verdict: &str,
+        p: Vec3,
+        radius: f32,
+        ours: Option<PointHit>,
+        reference: Option<PointHit>,
+    ) -> DisputedPoint {
+        let record = |h: PointHit| PointRecord {
+            prim: h.prim,
+            point: h.point.to_array(),
+            distance: h.distance,
+            distance_bits: format!("{:#010x}", h.distance.to_bits()),
+        };
+        DisputedPoint {
+            index,
+            verdict: verdict.to_string(),
+            point_bits: p
+                .to_array()
+                .iter()
+                .map(|c| format!("{:#010x}", c.to_bits()))
+                .collect(),
+            point: p.to_array(),
+            radius: radius.is_finite().then_some(radius),
+            ours: ours.map(record),
+            reference: reference.map(record),
+        }
+    }
+}
+
 impl Report {
-    /// Writes `dir/report.json` atomically: a temporary file in the same directory, flushed to
-    /// disk, then renamed over the target, so readers never see a half-written report.
+    /// Writes `dir/report.json` atomically (see [`crate::atomic`]): readers never see a
+    /// half-written report, and a failed write leaves no temporary file.
     pub fn write_atomic(&self, dir: &Path) -> anyhow::Result<std::path::PathBuf> {
-        use anyhow::Context;
-        use std::io::Write;
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        let target = dir.join("report.json");
-        let tmp = dir.join(format!(".report.json.{}.tmp", std::process::id()));
-        let json = serde_json::to_vec_pretty(self).context("serialising the report")?;
-        let mut f =
-            std::fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
-        f.write_all(&json)
-            .and_then(|_| f.sync_all())
-            .with_context(|| format!("writing {}", tmp.display()))?;
-        std::fs::rename(&tmp, &target)
-            .with_context(|| format!("renaming {} to {}", tmp.display(), target.display()))?;
-        Ok(target)
+        write_json_atomic(dir, "report.json", self)
     }
 
     pub fn read(path: &Path) -> anyhow::Result<Report> {
@@ -300,4 +362,35 @@ impl Report {
             .map(|w| w.validation.counts.mismatch + w.validation.counted_path_differs)
             .sum()
     }
+}
+
+/// True for a closest-point workload's name (`points-near`, `points-volume`).
+pub fn is_point_workload(workload: &str) -> bool {
+    workload
+        .parse::<raybench_scenes::Workload>()
+        .is_ok_and(|w| w.is_point_query())
+}
+
+/// What a workload's `mrays_per_s` counts: "Mqueries/s" for closest-point workloads,
+/// "Mrays/s" for ray workloads.
+pub fn throughput_unit(workload: &str) -> &'static str {
+    if is_point_workload(workload) {
+        "Mqueries/s"
+    } else {
+        "Mrays/s"
+    }
+}
+
+/// Serialises `value` as pretty JSON into `dir/name`, atomically, creating `dir` if needed.
+pub fn write_json_atomic<T: Serialize>(
+    dir: &Path,
+    name: &str,
+    value: &T,
+) -> anyhow::Result<std::path::PathBuf> {
+    use anyhow::Context;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let target = dir.join(name);
+    let json = serde_json::to_vec_pretty(value).with_context(|| format!("serialising {name}"))?;
+    crate::atomic::write_atomic(&target, &json)?;
+    Ok(target)
 }

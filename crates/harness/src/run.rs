@@ -1,17 +1,26 @@
-//! `raybench run`: load scenes, generate one ray set per workload from the reference, build and
-//! time every structure, count, validate, and assemble the report.
+//! `raybench run`: load scenes, generate one ray set (or query point set) per workload from the
+//! reference, build and time every structure, count, validate, and assemble the report.
+//!
+//! Ray workloads and closest-point workloads share the pipeline (build once, warm-up + median
+//! of timed passes, an untimed counted pass, validation against the reference) but not the code
+//! that handles rays: [`SceneRun`] keeps the two kinds in separate lists.
 
+use crate::dump::DumpDir;
 use crate::env::Environment;
 use crate::images::{PixelInput, PrimaryImage, shade};
-use crate::measure::{Answers, count_pass, time_builds, time_traces};
+use crate::measure::{
+    Answers, count_pass, count_point_pass, point_pass, time_builds, time_point_queries, time_traces,
+};
 use crate::registry::{self, BuildContext, StructureEntry};
 use crate::report::*;
-use crate::validate::{Sides, count_differences, validate};
+use crate::validate::{
+    Sides, count_differences, count_point_differences, validate, validate_points,
+};
 use anyhow::{Context, Result, bail};
-use raybench_accel::Accel;
 use raybench_accel::compare::Tolerance;
+use raybench_accel::{Accel, PointHit};
 use raybench_embree::{Device, EmbreeParams, fpu};
-use raybench_geom::Ray;
+use raybench_geom::{Ray, Vec3};
 use raybench_scenes::{Scene, SuiteScene, SurfaceHit, WhittedParams, Workload};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -25,6 +34,8 @@ pub struct RunOptions {
     pub structures: Vec<String>,
     pub workloads: Vec<Workload>,
     pub rays: usize,
+    /// Query points per closest-point workload.
+    pub points: usize,
     pub threads: usize,
     pub reference: String,
     pub seed: u64,
@@ -35,6 +46,8 @@ pub struct RunOptions {
     /// Keep per-pixel pictures of the primary workload in the report (see `images`); off for
     /// baselines, which are compared, not looked at.
     pub images: bool,
+    /// Write every structure's answers to every workload here (see [`crate::dump`]).
+    pub dump_hits: Option<PathBuf>,
 }
 
 /// A scene to load: by spec, or a suite file entry (with its `optional` flag).
@@ -45,7 +58,7 @@ pub enum SceneRequest {
 }
 
 impl SceneRequest {
-    fn label(&self) -> String {
+    pub(crate) fn label(&self) -> String {
         match self {
             SceneRequest::Spec(s) => s.clone(),
             SceneRequest::File { path, .. } => path.display().to_string(),
@@ -99,12 +112,12 @@ pub fn suite_requests(manifest: &Path, scenes: &[SuiteScene]) -> Vec<SceneReques
 }
 
 /// Live progress on a terminal; one plain line per step on stderr otherwise (CI logs).
-struct Progress {
+pub(crate) struct Progress {
     bar: Option<indicatif::ProgressBar>,
 }
 
 impl Progress {
-    fn new(enabled: bool, steps: u64) -> Progress {
+    pub(crate) fn new(enabled: bool, steps: u64) -> Progress {
         let bar = enabled.then(|| {
             let pb = indicatif::ProgressBar::new(steps);
             if let Ok(style) =
@@ -118,7 +131,7 @@ impl Progress {
     }
 
     /// Called between measurements only, never inside a timed region.
-    fn step(&self, msg: String) {
+    pub(crate) fn step(&self, msg: String) {
         match &self.bar {
             Some(pb) => {
                 pb.set_message(msg);
@@ -128,52 +141,153 @@ impl Progress {
         }
     }
 
-    fn note(&self, msg: String) {
+    pub(crate) fn note(&self, msg: String) {
         match &self.bar {
             Some(pb) => pb.println(msg),
             None => eprintln!("raybench: {msg}"),
         }
     }
 
-    fn finish(&self) {
+    pub(crate) fn finish(&self) {
         if let Some(pb) = &self.bar {
             pb.finish_and_clear();
         }
     }
 }
 
-/// Runs everything and returns the report (not yet written).
+/// The worker pool every build and trace runs in, with the run's FPU state on every worker, and
+/// the environment fingerprint read on one of its workers (shared by `run` and `verify`).
+pub(crate) struct Workers {
+    pub pool: rayon::ThreadPool,
+    pub environment: Environment,
+}
+
+impl Workers {
+    pub(crate) fn start(threads: usize, ftz: bool) -> Result<Workers> {
+        anyhow::ensure!(threads >= 1, "--threads must be at least 1 (got {threads})");
+        fpu::set_ftz_daz(ftz);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|i| format!("raybench-worker-{i}"))
+            .start_handler(move |_| fpu::set_ftz_daz(ftz))
+            .build()
+            .context("creating the thread pool")?;
+        let config = EmbreeParams {
+            threads,
+            ..EmbreeParams::medium()
+        }
+        .config_string();
+        let device = Device::shared(&config)
+            .map_err(|e| anyhow::anyhow!("creating the Embree device ({config}): {e}"))?;
+        let mxcsr = pool.install(fpu::mxcsr);
+        let environment = Environment::capture(threads, mxcsr, device.info());
+        Ok(Workers { pool, environment })
+    }
+}
+
+/// Notes and errors collected while a run goes on (both end up in its report).
+#[derive(Debug, Default)]
+pub(crate) struct Log {
+    pub notes: Vec<String>,
+    pub errors: Vec<String>,
+}
+
+/// Loads every requested scene in turn, names it uniquely and hands it to `visit`. An absent
+/// optional file becomes a note and a load failure an error; the run goes on either way.
+pub(crate) fn for_each_scene(
+    requests: &[SceneRequest],
+    seed: u64,
+    progress: &Progress,
+    log: &mut Log,
+    mut visit: impl FnMut(&SceneRequest, &LoadedScene, &mut Log),
+) {
+    let mut used_names = std::collections::HashSet::new();
+    for request in requests {
+        let mut scene = match catch_panic(|| load(request, seed)) {
+            Ok(Some(s)) => s,
+            Ok(None) => {
+                let note = format!("skipped {}: optional scene file is absent", request.label());
+                progress.note(note.clone());
+                log.notes.push(note);
+                continue;
+            }
+            Err(e) => {
+                let err = format!("scene {}: {e:#}", request.label());
+                progress.note(err.clone());
+                log.errors.push(err);
+                continue;
+            }
+        };
+        scene.scene.name = unique_name(request.report_name(), &mut used_names);
+        visit(request, &scene, log);
+    }
+}
+
+/// Runs `work`, turning a panic (a bug in a structure or generator) into an error, so one bad
+/// structure costs its own result, not the whole run and its report.
+pub(crate) fn catch_panic<T>(work: impl FnOnce() -> Result<T>) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
+        .unwrap_or_else(|payload| Err(anyhow::anyhow!("panicked: {}", panic_message(&*payload))))
+}
+
+/// The message a panic was raised with (`panic!("…")` carries a `&str` or a `String`).
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".into())
+}
+
+/// Checks what can be checked before any work: generator specs (names, parameters), and that
+/// OBJ files that are not optional exist. A bad scene then fails the command at once, before
+/// a report or dump is written, instead of after the scenes listed before it were measured.
+pub fn check_requests(requests: &[SceneRequest]) -> Result<()> {
+    for request in requests {
+        match request {
+            SceneRequest::Spec(spec) if is_obj_path(spec) => check_file_exists(Path::new(spec))?,
+            SceneRequest::Spec(spec) => {
+                raybench_scenes::check_spec(spec).with_context(|| format!("scene '{spec}'"))?
+            }
+            SceneRequest::File { path, optional } => {
+                if !*optional {
+                    check_file_exists(path)?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn is_obj_path(spec: &str) -> bool {
+    spec.to_ascii_lowercase().ends_with(".obj")
+}
+
+fn check_file_exists(path: &Path) -> Result<()> {
+    std::fs::metadata(path)
+        .map(|_| ())
+        .with_context(|| format!("scene file {}", path.display()))
+}
+
+/// Runs everything and returns the report (not yet written). With `dump_hits`, every
+/// structure's answers are written there as they are measured (see [`crate::dump`]).
 pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
-    anyhow::ensure!(opts.threads >= 1, "--threads must be at least 1");
-    anyhow::ensure!(opts.rays >= 1, "--rays must be at least 1");
+    anyhow::ensure!(opts.rays >= 1, "--rays must be at least 1 (got 0)");
+    anyhow::ensure!(opts.points >= 1, "--points must be at least 1 (got 0)");
     let mut structures = registry::select(&opts.structures)?;
     let reference_entry = registry::find(&opts.reference)?;
-    let mut notes = Vec::new();
+    let mut log = Log::default();
     if !structures.iter().any(|e| e.name == reference_entry.name) {
-        notes.push(format!(
+        log.notes.push(format!(
             "reference {} added to the measured structures so ratios can be computed",
             opts.reference
         ));
         structures.insert(0, registry::find(&opts.reference)?);
     }
-    let ftz = opts.ftz_daz;
-    fpu::set_ftz_daz(ftz);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
-        .thread_name(|i| format!("raybench-worker-{i}"))
-        .start_handler(move |_| fpu::set_ftz_daz(ftz))
-        .build()
-        .context("creating the thread pool")?;
-    let config = EmbreeParams {
-        threads: opts.threads,
-        ..EmbreeParams::medium()
-    }
-    .config_string();
-    let device = Device::shared(&config)
-        .map_err(|e| anyhow::anyhow!("creating the Embree device ({config}): {e}"))?;
-    let mxcsr = pool.install(fpu::mxcsr);
-    let environment = Environment::capture(opts.threads, mxcsr, device.info());
-
+    let mut dump = opts.dump_hits.as_deref().map(DumpDir::create).transpose()?;
+    log.notes
+        .extend(points_not_dumped(dump.is_some(), &opts.workloads));
+    let workers = Workers::start(opts.threads, opts.ftz_daz)?;
     let tol = Tolerance::default();
     let progress = Progress::new(
         opts.progress,
@@ -182,11 +296,12 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
     let mut report = Report {
         schema_version: SCHEMA_VERSION,
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        environment,
+        environment: workers.environment.clone(),
         run: RunSettings {
             suite: opts.suite.clone(),
             seed: opts.seed,
             rays: opts.rays,
+            points: opts.points,
             threads: opts.threads,
             reference: opts.reference.clone(),
             build_runs: opts.build_runs,
@@ -202,63 +317,54 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
         },
         scenes: Vec::new(),
         results: Vec::new(),
-        notes,
+        notes: Vec::new(),
         errors: Vec::new(),
     };
     let explicit = opts.suite.is_none();
-    let mut used_names = std::collections::HashSet::new();
-    pool.install(|| {
-        for request in scenes {
-            let mut scene = match load(request, opts.seed) {
-                Ok(Some(s)) => s,
-                Ok(None) => {
-                    let note = format!("skipped {}: optional scene file is absent", request.label());
-                    progress.note(note.clone());
-                    report.notes.push(note);
-                    continue;
-                }
-                Err(e) => {
-                    let err = format!("scene {}: {e:#}", request.label());
-                    progress.note(err.clone());
-                    report.errors.push(err);
-                    continue;
-                }
+    workers.pool.install(|| {
+        for_each_scene(scenes, opts.seed, &progress, &mut log, |_, scene, log| {
+            let name = &scene.scene.name;
+            progress.step(format!("{name}: generating workloads with {}", reference_entry.name));
+            let prepared = catch_panic(|| {
+                let counts = QueryCounts { rays: opts.rays, points: opts.points };
+                SceneRun::prepare(scene, &opts.workloads, counts, opts.seed, opts.threads, &reference_entry)
+            });
+            let sr = match prepared {
+                Ok(sr) => sr,
+                Err(e) => return log.errors.push(format!("scene {name}: {e:#}")),
             };
-            scene.scene.name = unique_name(request.report_name(), &mut used_names);
-            progress.step(format!("{}: generating workloads with {}", scene.scene.name, reference_entry.name));
-            match SceneRun::prepare(&scene, opts, &reference_entry) {
-                Ok(sr) => {
-                    report.scenes.push(sr.record(&scene));
-                    for entry in &structures {
-                        if let Some(limit) = entry.suite_triangle_limit.filter(|&l| !explicit && scene.scene.mesh.len() > l) {
-                            report.notes.push(format!(
-                                "{} skipped on {} ({} triangles > its suite limit {limit}); name it with --structures to run it",
-                                entry.name,
-                                scene.scene.name,
-                                scene.scene.mesh.len()
-                            ));
-                            progress.step(format!("{}: {} skipped", scene.scene.name, entry.name));
-                            continue;
-                        }
-                        progress.step(format!("{}: {}", scene.scene.name, entry.name));
-                        match sr.measure(entry, opts, &tol) {
-                            Ok(r) => report.results.push(r),
-                            Err(e) => report.errors.push(format!("{} on {}: {e:#}", entry.name, scene.scene.name)),
-                        }
-                    }
+            report.scenes.push(sr.record(scene));
+            for entry in &structures {
+                if let Some(limit) = entry.suite_triangle_limit.filter(|&l| !explicit && scene.scene.mesh.len() > l) {
+                    log.notes.push(format!(
+                        "{} skipped on {name} ({} triangles > its suite limit {limit}); name it with --structures to run it",
+                        entry.name,
+                        scene.scene.mesh.len()
+                    ));
+                    progress.step(format!("{name}: {} skipped", entry.name));
+                    continue;
                 }
-                Err(e) => report.errors.push(format!("scene {}: {e:#}", scene.scene.name)),
+                progress.step(format!("{name}: {}", entry.name));
+                match catch_panic(|| sr.measure(entry, opts, &tol, dump.as_mut())) {
+                    Ok(r) => report.results.push(r),
+                    Err(e) => log.errors.push(format!("{} on {name}: {e:#}", entry.name)),
+                }
             }
-        }
+        });
     });
     progress.finish();
+    report.notes.append(&mut log.notes);
+    report.errors.append(&mut log.errors);
+    if let Some(dump) = dump {
+        dump.finish()?;
+    }
     fill_ratios(&mut report);
     Ok(report)
 }
 
-struct LoadedScene {
-    scene: Scene,
-    load_ms: f64,
+pub(crate) struct LoadedScene {
+    pub scene: Scene,
+    pub load_ms: f64,
 }
 
 fn load(request: &SceneRequest, seed: u64) -> Result<Option<LoadedScene>> {
@@ -279,81 +385,80 @@ fn load(request: &SceneRequest, seed: u64) -> Result<Option<LoadedScene>> {
 }
 
 /// One workload's rays (the same for every structure) and the reference's answers to them.
-struct PreparedWorkload {
-    workload: Workload,
-    rays: Vec<Ray>,
-    reference: Answers,
+pub(crate) struct PreparedWorkload {
+    pub workload: Workload,
+    pub rays: Vec<Ray>,
+    /// The reference's answers, traced on the timed path.
+    pub reference: Answers,
     size: Option<(u32, u32)>,
 }
 
+/// One closest-point workload's query points (the same for every structure) and the
+/// reference's answers to them.
+pub(crate) struct PreparedPoints {
+    pub workload: Workload,
+    pub points: Vec<Vec3>,
+    /// The search radius every structure is asked with (the workload's: infinite).
+    pub radius: f32,
+    /// The reference's answers, on its timed path.
+    pub reference: Vec<Option<PointHit>>,
+}
+
+/// How many queries each kind of workload asks.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct QueryCounts {
+    /// Rays per ray workload (primary: about this many pixels).
+    pub rays: usize,
+    /// Query points per closest-point workload.
+    pub points: usize,
+}
+
 /// A scene with its workloads generated and the reference built.
-struct SceneRun<'a> {
-    scene: &'a LoadedScene,
-    reference: Box<dyn Accel>,
-    reference_name: String,
-    workloads: Vec<PreparedWorkload>,
+pub(crate) struct SceneRun<'a> {
+    pub scene: &'a LoadedScene,
+    pub reference: Box<dyn Accel>,
+    pub reference_name: String,
+    /// The ray workloads, in the order asked.
+    pub workloads: Vec<PreparedWorkload>,
+    /// The closest-point workloads, in the order asked.
+    pub point_workloads: Vec<PreparedPoints>,
 }
 
 impl<'a> SceneRun<'a> {
-    fn prepare(
+    /// Builds the reference and generates every workload's rays with it (secondary rays start
+    /// at its primary hits) or its query points, and its answers to them.
+    pub(crate) fn prepare(
         scene: &'a LoadedScene,
-        opts: &RunOptions,
+        workloads: &[Workload],
+        counts: QueryCounts,
+        seed: u64,
+        threads: usize,
         reference_entry: &StructureEntry,
     ) -> Result<SceneRun<'a>> {
         let s = &scene.scene;
-        let ctx = BuildContext {
-            threads: opts.threads,
-        };
+        let ctx = BuildContext { threads };
         let reference = reference_entry.build(s.mesh.clone(), &ctx)?.accel;
-        let bounds = s.mesh.bounds();
-        let (primary, w, h) = raybench_scenes::primary_rays(&s.view, &bounds, opts.rays);
-        let surface: Vec<Option<SurfaceHit>> = primary
+        let (points, rays): (Vec<Workload>, Vec<Workload>) =
+            workloads.iter().partition(|w| w.is_point_query());
+        let prepared = if rays.is_empty() {
+            Vec::new()
+        } else {
+            ray_workloads(s, reference.as_ref(), &rays, counts.rays, seed, threads)?
+        };
+        let point_workloads = points
             .iter()
-            .map(|r| {
-                reference.intersect(r).map(|h| SurfaceHit {
-                    prim: h.prim,
-                    u: h.u,
-                    v: h.v,
-                })
-            })
-            .collect();
-        let mut workloads = Vec::new();
-        for &wl in &opts.workloads {
-            let seed = opts.seed;
-            let (rays, size) = match wl {
-                Workload::Primary => (primary.clone(), Some((w, h))),
-                Workload::Random => (raybench_scenes::random_rays(&bounds, opts.rays, seed), None),
-                Workload::Shadow => (
-                    raybench_scenes::shadow_rays(&s.mesh, s.view.light, &primary, &surface),
-                    None,
-                ),
-                Workload::Diffuse => (
-                    raybench_scenes::diffuse_rays(&s.mesh, &primary, &surface, seed),
-                    None,
-                ),
-                Workload::Whitted => (
-                    whitted_rays(s, reference.as_ref(), &primary, &surface),
-                    None,
-                ),
-            };
-            check_rays(wl, &rays)?;
-            let reference_answers = reference_answers(reference.as_ref(), &rays, wl.any_hit())?;
-            workloads.push(PreparedWorkload {
-                workload: wl,
-                rays,
-                reference: reference_answers,
-                size,
-            });
-        }
+            .map(|&wl| point_workload(s, reference.as_ref(), wl, counts.points, seed, threads))
+            .collect::<Result<_>>()?;
         Ok(SceneRun {
             scene,
             reference,
             reference_name: reference_entry.name.to_string(),
-            workloads,
+            workloads: prepared,
+            point_workloads,
         })
     }
 
-    fn record(&self, loaded: &LoadedScene) -> SceneRecord {
+    pub(crate) fn record(&self, loaded: &LoadedScene) -> SceneRecord {
         let s = &loaded.scene;
         SceneRecord {
             name: s.name.clone(),
@@ -369,9 +474,18 @@ impl<'a> SceneRun<'a> {
                     workload: w.workload.name().to_string(),
                     rays: w.rays.len(),
                     any_hit: w.workload.any_hit(),
+                    point_query: false,
                     width: w.size.map(|s| s.0),
                     height: w.size.map(|s| s.1),
                 })
+                .chain(self.point_workloads.iter().map(|w| WorkloadRecord {
+                    workload: w.workload.name().to_string(),
+                    rays: w.points.len(),
+                    any_hit: false,
+                    point_query: true,
+                    width: None,
+                    height: None,
+                }))
                 .collect(),
         }
     }
@@ -381,6 +495,7 @@ impl<'a> SceneRun<'a> {
         entry: &StructureEntry,
         opts: &RunOptions,
         tol: &Tolerance,
+        mut dump: Option<&mut DumpDir>,
     ) -> Result<ResultEntry> {
         let s = &self.scene.scene;
         let ctx = BuildContext {
@@ -416,6 +531,16 @@ impl<'a> SceneRun<'a> {
             let (mut validation, levels) =
                 validate(&s.mesh, &wl.rays, &answers, &wl.reference, &sides, tol);
             validation.counted_path_differs = count_differences(&answers, &counted);
+            if let Some(d) = dump.as_deref_mut() {
+                d.write(
+                    &s.name,
+                    entry.name,
+                    wl.workload.name(),
+                    &wl.rays,
+                    None,
+                    &answers,
+                )?;
+            }
             let has_counters = accel.has_counters();
             if let (true, Some((w, h)), Answers::Closest(hits)) = (opts.images, wl.size, &answers) {
                 let pixels: Vec<PixelInput> = (0..wl.rays.len())
@@ -431,6 +556,7 @@ impl<'a> SceneRun<'a> {
                 workload: wl.workload.name().to_string(),
                 rays: wl.rays.len(),
                 any_hit,
+                point_query: false,
                 mrays_per_s: mrays,
                 speedup_vs_reference: None,
                 counters_per_ray: has_counters
@@ -438,6 +564,9 @@ impl<'a> SceneRun<'a> {
                 counters_total: has_counters.then_some(counters),
                 validation,
             });
+        }
+        for pw in self.point_workloads.iter().filter(|w| !w.points.is_empty()) {
+            workloads.push(self.measure_points(accel, pw, opts));
         }
         let memory = accel.memory();
         Ok(ResultEntry {
@@ -454,6 +583,144 @@ impl<'a> SceneRun<'a> {
             primary_image,
         })
     }
+}
+
+/// The ray workloads of a scene: rays generated with the reference (secondary rays start at
+/// its primary hits) and its answers.
+fn ray_workloads(
+    s: &Scene,
+    reference: &dyn Accel,
+    workloads: &[Workload],
+    ray_count: usize,
+    seed: u64,
+    threads: usize,
+) -> Result<Vec<PreparedWorkload>> {
+    let bounds = s.mesh.bounds();
+    let (primary, w, h) = raybench_scenes::primary_rays(&s.view, &bounds, ray_count);
+    let surface: Vec<Option<SurfaceHit>> =
+        primary.iter().map(|r| surface_hit(reference, r)).collect();
+    let mut prepared = Vec::new();
+    for &wl in workloads {
+        let (rays, size) = match wl {
+            Workload::Primary => (primary.clone(), Some((w, h))),
+            Workload::Random => (raybench_scenes::random_rays(&bounds, ray_count, seed), None),
+            Workload::Shadow => (
+                raybench_scenes::shadow_rays(&s.mesh, s.view.light, &primary, &surface),
+                None,
+            ),
+            Workload::Diffuse => (
+                raybench_scenes::diffuse_rays(&s.mesh, &primary, &surface, seed),
+                None,
+            ),
+            Workload::Whitted => (whitted_rays(s, reference, &primary, &surface), None),
+            Workload::PointsNear | Workload::PointsVolume => {
+                bail!("{wl} is a closest-point workload, not a ray workload")
+            }
+        };
+        check_rays(wl, &rays)?;
+        let reference_answers = reference_answers(reference, &rays, wl.any_hit(), threads)?;
+        prepared.push(PreparedWorkload {
+            workload: wl,
+            rays,
+            reference: reference_answers,
+            size,
+        });
+    }
+    Ok(prepared)
+}
+
+/// A closest-point workload of a scene: its query points (a function of the mesh, the count
+/// and the seed only, so every thread count and run sees the same) and the reference's answers.
+fn point_workload(
+    s: &Scene,
+    reference: &dyn Accel,
+    workload: Workload,
+    count: usize,
+    seed: u64,
+    threads: usize,
+) -> Result<PreparedPoints> {
+    let kind = workload
+        .point_workload()
+        .context("a ray workload among the point workloads")?;
+    let points = kind.generate(&s.mesh, count, seed);
+    let radius = kind.default_radius();
+    check_points(workload, &points, radius)?;
+    let mut answers = vec![None; points.len()];
+    point_pass(reference, &points, radius, threads, &mut answers);
+    Ok(PreparedPoints {
+        workload,
+        points,
+        radius,
+        reference: answers,
+    })
+}
+
+/// Every generated query must be one Embree can take; a bad one is a generator bug, named here.
+fn check_points(wl: Workload, points: &[Vec3], radius: f32) -> Result<()> {
+    for (i, &p) in points.iter().enumerate() {
+        if raybench_geom::query_radius_squared(p, radius).is_none() {
+            bail!(
+                "workload {} point {i} is not a valid query (bits {:08x?})",
+                wl.name(),
+                p.to_array().map(f32::to_bits)
+            );
+        }
+    }
+    Ok(())
+}
+
+impl SceneRun<'_> {
+    /// One structure on one closest-point workload: timed like rays (warm-up, median of
+    /// `trace_runs` passes on the run's threads), then the counted pass, then validation
+    /// against the reference. Not dumped: `--dump-hits` covers ray workloads only.
+    fn measure_points(
+        &self,
+        accel: &dyn Accel,
+        pw: &PreparedPoints,
+        opts: &RunOptions,
+    ) -> WorkloadResult {
+        let (answers, throughput) =
+            time_point_queries(accel, &pw.points, pw.radius, opts.threads, opts.trace_runs);
+        let (counted, counters) = count_point_pass(accel, &pw.points, pw.radius);
+        let mesh = &self.scene.scene.mesh;
+        let mut validation = validate_points(
+            mesh,
+            &pw.points,
+            pw.radius,
+            &answers,
+            &pw.reference,
+            &self.reference_name,
+        );
+        validation.counted_path_differs = count_point_differences(&answers, &counted);
+        let has_counters = accel.has_counters();
+        WorkloadResult {
+            workload: pw.workload.name().to_string(),
+            rays: pw.points.len(),
+            any_hit: false,
+            point_query: true,
+            mrays_per_s: throughput,
+            speedup_vs_reference: None,
+            counters_per_ray: has_counters
+                .then(|| CountersPerRay::from_total(&counters, pw.points.len())),
+            counters_total: has_counters.then_some(counters),
+            validation,
+        }
+    }
+}
+
+/// The note a run or verify with `--dump-hits` and closest-point workloads carries.
+pub(crate) fn points_not_dumped(dumping: bool, workloads: &[Workload]) -> Option<String> {
+    let points: Vec<&str> = workloads
+        .iter()
+        .filter(|w| w.is_point_query())
+        .map(Workload::name)
+        .collect();
+    (dumping && !points.is_empty()).then(|| {
+        format!(
+            "--dump-hits covers ray workloads only: {} not dumped",
+            points.join(", ")
+        )
+    })
 }
 
 /// Knobs of the recursive `whitted` workload, written into the report's run settings.
@@ -519,12 +786,18 @@ fn check_rays(wl: Workload, rays: &[Ray]) -> Result<()> {
     Ok(())
 }
 
-fn reference_answers(reference: &dyn Accel, rays: &[Ray], any_hit: bool) -> Result<Answers> {
+/// A reference's answers on its timed path (the thread count changes only the speed).
+pub(crate) fn reference_answers(
+    reference: &dyn Accel,
+    rays: &[Ray],
+    any_hit: bool,
+    threads: usize,
+) -> Result<Answers> {
     let prepared = reference
         .prepare_rays(rays)
-        .map_err(|e| anyhow::anyhow!("reference rejected a ray: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("{} rejected a ray: {e}", reference.name()))?;
     let mut answers = Answers::new(any_hit, rays.len());
-    crate::measure::trace_pass(reference, rays, &prepared, 1, &mut answers);
+    crate::measure::trace_pass(reference, rays, &prepared, threads, &mut answers);
     Ok(answers)
 }
 
@@ -549,5 +822,33 @@ fn fill_ratios(report: &mut Report) {
                 .filter(|b| b.mrays_per_s.median > 0.0)
                 .map(|b| w.mrays_per_s.median / b.mrays_per_s.median);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_becomes_an_error_naming_its_message() {
+        let err = catch_panic::<()>(|| panic!("bad node {}", 7)).unwrap_err();
+        assert_eq!(err.to_string(), "panicked: bad node 7");
+        assert_eq!(catch_panic(|| Ok(5)).unwrap(), 5);
+    }
+
+    #[test]
+    fn bad_specs_and_missing_files_are_found_before_any_work() {
+        let ok = SceneRequest::Spec("sphere:triangles=100".into());
+        let optional = SceneRequest::File {
+            path: "/nonexistent/optional.obj".into(),
+            optional: true,
+        };
+        assert!(check_requests(&[ok.clone(), optional]).is_ok());
+        let bad = SceneRequest::Spec("sphere:triangles=-5".into());
+        let err = format!("{:#}", check_requests(&[ok.clone(), bad]).unwrap_err());
+        assert!(err.contains("sphere:triangles=-5"), "{err}");
+        let missing = SceneRequest::Spec("/nonexistent/scene.OBJ".into());
+        let err = format!("{:#}", check_requests(&[ok, missing]).unwrap_err());
+        assert!(err.contains("/nonexistent/scene.OBJ"), "{err}");
     }
 }

@@ -1,11 +1,12 @@
-//! Checks a structure's answers against the reference's, ray by ray, with the validation
-//! classes of `raybench_accel::compare`.
+//! Checks a structure's answers against the reference's, ray by ray (or query point by query
+//! point), with the validation classes of `raybench_accel::compare` (and `compare_points`).
 
 use crate::measure::Answers;
-use crate::report::{DisputedRay, Validation};
-use raybench_accel::Accel;
+use crate::report::{DisputedPoint, DisputedRay, Validation};
 use raybench_accel::compare::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
-use raybench_geom::{Ray, TriangleMesh};
+use raybench_accel::compare_points::{classify_point, point_tolerance};
+use raybench_accel::{Accel, PointHit};
+use raybench_geom::{Ray, TriangleMesh, Vec3};
 
 /// Disputed rays kept per class in the report.
 const KEEP_EXAMPLES: usize = 10;
@@ -94,6 +95,39 @@ pub fn verdict_name(v: Verdict) -> &'static str {
         Verdict::EdgeAmbiguous => "edge_ambiguous",
         Verdict::Mismatch => "mismatch",
     }
+}
+
+/// Classifies every closest-point answer against the reference's (`compare_points`: the
+/// tolerance scales with the magnitude of the scene and the point); the first mismatches are
+/// kept with the point's bits.
+pub fn validate_points(
+    mesh: &TriangleMesh,
+    points: &[Vec3],
+    radius: f32,
+    ours: &[Option<PointHit>],
+    reference: &[Option<PointHit>],
+    reference_name: &str,
+) -> Validation {
+    let bounds = mesh.bounds();
+    let mut counts = VerdictCounts::default();
+    let mut mismatches = Vec::new();
+    for (i, ((&p, &a), &b)) in points.iter().zip(ours).zip(reference).enumerate() {
+        let verdict = classify_point(mesh, p, radius, a, b, point_tolerance(&bounds, p));
+        counts.add(verdict);
+        if verdict == Verdict::Mismatch && mismatches.len() < KEEP_EXAMPLES {
+            let name = verdict_name(verdict);
+            mismatches.push(DisputedPoint::new(i, name, p, radius, a, b));
+        }
+    }
+    let mut v = Validation::new(reference_name, counts);
+    v.first_point_mismatches = mismatches;
+    v
+}
+
+/// Queries where the counted walk answered differently from the timed path.
+pub fn count_point_differences(timed: &[Option<PointHit>], counted: &[Option<PointHit>]) -> u64 {
+    let differing = timed.iter().zip(counted).filter(|(a, b)| a != b).count();
+    (differing + timed.len().abs_diff(counted.len())) as u64
 }
 
 /// Rays where the counted walk answered differently from the timed path.

@@ -89,6 +89,8 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
             "ci",
             "--rays",
             "3000",
+            "--points",
+            "300",
             "--build-runs",
             "1",
             "--trace-runs",
@@ -107,6 +109,17 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
     let report = raybench_harness::report::Report::read(&dir.join("report.json")).unwrap();
     assert_eq!(report.mismatches(), 0);
     assert!(report.errors.is_empty(), "{:?}", report.errors);
+    let points_near = report
+        .results
+        .iter()
+        .flat_map(|r| &r.workloads)
+        .filter(|w| w.workload == "points-near" && w.point_query && w.rays == 300)
+        .count();
+    assert!(
+        points_near >= 9 * 14,
+        "ci runs points-near on every scene: {points_near}"
+    );
+    assert!(stdout.contains("points-near Mq/s"), "{stdout}");
     let scenes: Vec<&str> = report.scenes.iter().map(|s| s.name.as_str()).collect();
     for generator in [
         "sphere",
@@ -152,4 +165,375 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
         );
     }
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Exit code, stdout and stderr of one invocation.
+fn invoke(args: &[&str]) -> (i32, String, String) {
+    let out = raybench().args(args).output().unwrap();
+    (
+        out.status.code().expect("exited, not killed by a signal"),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A fresh, empty scratch directory for one test.
+fn scratch(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("raybench-cli-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Every file below `dir`, relative, sorted.
+fn files_below(dir: &std::path::Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push(p.strip_prefix(dir).unwrap().display().to_string());
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The error is on the first line of stderr and names `bad`; no panic, no backtrace.
+fn assert_clear_error(args: &[&str], bad: &str) {
+    let (code, _, stderr) = invoke(args);
+    assert_eq!(code, 1, "{args:?}: {stderr}");
+    let first = stderr.lines().next().unwrap_or_default();
+    assert!(
+        first.contains(bad),
+        "{args:?}: the first line does not name {bad}: {stderr}"
+    );
+    assert!(
+        first.starts_with("raybench: error:") || first.starts_with("error:"),
+        "{stderr}"
+    );
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("backtrace"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn bad_numbers_name_the_value_and_exit_1() {
+    let cases: [(&[&str], &str); 8] = [
+        (&["run", "--scenes", "sphere", "--rays", "0"], "'0'"),
+        (&["run", "--scenes", "sphere", "--rays", "abc"], "'abc'"),
+        (&["run", "--scenes", "sphere", "--threads", "0"], "'0'"),
+        (&["run", "--scenes", "sphere", "--seed", "x12"], "'x12'"),
+        (&["verify", "--scenes", "sphere", "--rays", "-3"], "'-3'"),
+        (
+            &["verify", "--scenes", "sphere", "--threads", "two"],
+            "'two'",
+        ),
+        (
+            &["verify", "--scenes", "sphere", "--brute-force-budget", "0"],
+            "'0'",
+        ),
+        (&["watertight", "--rays", "1.5"], "'1.5'"),
+    ];
+    for (args, bad) in cases {
+        assert_clear_error(args, bad);
+    }
+}
+
+const GOOD_RAY: &str =
+    "0x3dcccccd,0x3e4ccccd,0x40400000,0x00000000,0x00000000,0xbf800000,0x00000000,0x7f800000";
+
+#[test]
+fn unknown_names_are_one_line_errors() {
+    let cases: [(&[&str], &str); 7] = [
+        (&["run", "--scenes", "nosuchgen"], "nosuchgen"),
+        (
+            &["run", "--scenes", "sphere,/nonexistent/x.obj"],
+            "/nonexistent/x.obj",
+        ),
+        (
+            &["verify", "--scenes", "sphere", "--structures", "bvh-nope"],
+            "bvh-nope",
+        ),
+        (&["verify", "--suite", "nope-suite"], "nope-suite"),
+        (
+            &["run", "--scenes", "sphere", "--reference", "embree-nope"],
+            "embree-nope",
+        ),
+        (
+            &["replay", "--scene", "nosuchgen", "--ray", GOOD_RAY],
+            "nosuchgen",
+        ),
+        (
+            &[
+                "replay",
+                "--scene",
+                "sphere",
+                "--structure",
+                "nope",
+                "--ray",
+                GOOD_RAY,
+            ],
+            "nope",
+        ),
+    ];
+    for (args, bad) in cases {
+        assert_clear_error(args, bad);
+        let (_, _, stderr) = invoke(args);
+        assert_eq!(
+            stderr.lines().count(),
+            1,
+            "{args:?}: one line, not {stderr}"
+        );
+    }
+    assert_clear_error(
+        &["verify", "--scenes", "sphere", "--workloads", "sideways"],
+        "sideways",
+    );
+}
+
+#[test]
+fn point_workloads_run_from_the_command_line_and_unknown_ones_are_refused() {
+    let dir = scratch("points");
+    let (code, stdout, stderr) = invoke(&[
+        "run",
+        "--scenes",
+        "sphere:triangles=600",
+        "--structures",
+        "bvh-binned,embree-medium",
+        "--workloads",
+        "points-near",
+        "--points",
+        "250",
+        "--no-images",
+        "--trace-runs",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    assert!(stdout.contains("points-near Mq/s"), "{stdout}");
+    assert!(stdout.contains("Closest-point work per query"), "{stdout}");
+    let report = raybench_harness::report::Report::read(&dir.join("report.json")).unwrap();
+    assert_eq!(report.run.workloads, ["points-near"]);
+    assert_eq!(report.run.points, 250);
+    for r in &report.results {
+        let w = &r.workloads[..];
+        assert!(
+            w.len() == 1 && w[0].point_query && w[0].rays == 250,
+            "{w:?}"
+        );
+        assert_eq!(w[0].validation.counts.mismatch, 0);
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+    for command in ["run", "verify"] {
+        let args = [command, "--scenes", "sphere", "--workloads", "points-far"];
+        assert_clear_error(&args, "points-far");
+    }
+    assert_clear_error(&["run", "--scenes", "sphere", "--points", "0"], "'0'");
+}
+
+#[test]
+fn an_unwritable_out_fails_before_any_work_and_leaves_nothing() {
+    let dir = scratch("unwritable");
+    std::fs::write(dir.join("blocker"), b"a file, not a directory").unwrap();
+    let out = dir.join("blocker").join("reports");
+    let out = out.to_str().unwrap();
+    for cmd in ["run", "verify"] {
+        let args = [
+            cmd,
+            "--scenes",
+            "sphere:triangles=200",
+            "--rays",
+            "100",
+            "--out",
+            out,
+        ];
+        assert_clear_error(&args, "blocker");
+    }
+    let dumps = dir.join("blocker").join("hits");
+    let (ok, dumps) = (dir.join("ok"), dumps.to_str().unwrap());
+    let args = [
+        "verify",
+        "--scenes",
+        "sphere:triangles=200",
+        "--out",
+        ok.to_str().unwrap(),
+    ];
+    let (code, _, stderr) = invoke(&[&args[..], &["--dump-hits", dumps]].concat());
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("--dump-hits") && stderr.contains("blocker"),
+        "{stderr}"
+    );
+    assert!(
+        !ok.exists(),
+        "a bad --dump-hits is found before --out is created"
+    );
+    assert_eq!(
+        files_below(&dir),
+        ["blocker"],
+        "nothing written, no temporary file"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn an_invalid_scene_after_a_valid_one_stops_before_anything_is_written() {
+    let dir = scratch("invalid-after-valid");
+    let out = dir.join("out");
+    for cmd in ["run", "verify"] {
+        let (code, stdout, stderr) = invoke(&[
+            cmd,
+            "--scenes",
+            "sphere:triangles=200,nosuchgen:size=2",
+            "--rays",
+            "100",
+            "--out",
+            out.to_str().unwrap(),
+            "--dump-hits",
+            out.join("hits").to_str().unwrap(),
+        ]);
+        assert_eq!(code, 1, "{stdout}{stderr}");
+        assert!(stderr.contains("nosuchgen"), "{stderr}");
+    }
+    assert!(!out.exists(), "{:?}", files_below(&dir));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A file that exists but cannot be loaded is found only when its turn comes: the run goes on,
+/// the report is complete (it parses, it names the file), the exit status is 1, and no
+/// temporary file is left behind.
+#[test]
+fn a_scene_failing_midway_still_leaves_a_whole_report_and_no_temporary_file() {
+    let dir = scratch("midway");
+    let broken = dir.join("broken.obj");
+    std::fs::write(&broken, "v 0 0 0\nv 1 0\nf 1 2 3\n").unwrap();
+    let out = dir.join("out");
+    let scenes = format!("sphere:triangles=200,{}", broken.display());
+    let (code, stdout, stderr) = invoke(&[
+        "run",
+        "--scenes",
+        &scenes,
+        "--structures",
+        "grid",
+        "--rays",
+        "200",
+        "--build-runs",
+        "1",
+        "--trace-runs",
+        "1",
+        "--no-images",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let report = raybench_harness::report::Report::read(&out.join("report.json")).unwrap();
+    assert_eq!(report.errors.len(), 1, "{:?}", report.errors);
+    assert!(
+        report.errors[0].contains("broken.obj"),
+        "{:?}",
+        report.errors
+    );
+    assert!(report.results.iter().any(|r| r.structure == "grid"));
+    assert!(
+        files_below(&out).iter().all(|f| !f.contains(".tmp")),
+        "{:?}",
+        files_below(&out)
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn verify_passes_on_a_small_scene_and_writes_verify_json_and_dumps() {
+    let dir = scratch("verify");
+    let (code, stdout, stderr) = invoke(&[
+        "verify",
+        "--scenes",
+        "sphere:triangles=300",
+        "--structures",
+        "grid,bvh-binned",
+        "--rays",
+        "300",
+        "--out",
+        dir.to_str().unwrap(),
+        "--dump-hits",
+        dir.join("hits").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    for expected in [
+        "0 mismatches in",
+        "95% upper bound 3/n",
+        "Brute force checked",
+        "edge_amb",
+    ] {
+        assert!(stdout.contains(expected), "{expected}: {stdout}");
+    }
+    let report = raybench_harness::verify::VerifyReport::read(&dir.join("verify.json")).unwrap();
+    assert_eq!(
+        report.totals.len(),
+        2 * 3,
+        "two structures × three references"
+    );
+    let index = raybench_harness::dump::read_index(&dir.join("hits")).unwrap();
+    assert_eq!(index.files.len(), 2 * 5, "two structures × five workloads");
+    assert!(files_below(&dir).iter().all(|f| !f.contains(".tmp")));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn replay_prints_every_answer_and_rejects_bad_rays() {
+    let (code, stdout, stderr) = invoke(&[
+        "replay",
+        "--scene",
+        "sphere:triangles=300",
+        "--structure",
+        "grid",
+        "--ray",
+        GOOD_RAY,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    for expected in [
+        "origin (0.1, 0.2, 3)",
+        "double precision",
+        "closest hit:  prim",
+        "grid ",
+        "bruteforce ",
+        "embree-robust ",
+        "exact / exact",
+    ] {
+        assert!(stdout.contains(expected), "{expected}:\n{stdout}");
+    }
+    // The bits may come space-separated without 0x, as several arguments.
+    let spaced: Vec<&str> = GOOD_RAY
+        .split(',')
+        .map(|w| w.trim_start_matches("0x"))
+        .collect();
+    let mut args = vec![
+        "replay",
+        "--scene",
+        "sphere:triangles=300",
+        "--structure",
+        "grid",
+        "--ray",
+    ];
+    args.extend(spaced);
+    assert_eq!(invoke(&args).1, stdout);
+    let nan = GOOD_RAY.replacen("0x3dcccccd", "0x7fc00000", 1);
+    assert_clear_error(
+        &["replay", "--scene", "sphere", "--ray", &nan],
+        "origin.x is NaN",
+    );
+    let short = GOOD_RAY.rsplit_once(',').unwrap().0;
+    assert_clear_error(&["replay", "--scene", "sphere", "--ray", short], "got 7");
+    let bad_hex = GOOD_RAY.replacen("0x3dcccccd", "0xZZ", 1);
+    assert_clear_error(
+        &["replay", "--scene", "sphere", "--ray", &bad_hex],
+        "'0xZZ'",
+    );
 }

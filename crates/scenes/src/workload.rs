@@ -1,4 +1,8 @@
-//! Ray workloads. Each is a pure function of its inputs and seed.
+//! Workloads. Each is a pure function of its inputs and seed.
+//!
+//! [`Workload`] names every workload a run can ask for: five ray workloads (this module) and two
+//! closest-point workloads ([`crate::points`]), so the CLI, suite manifests and reports take
+//! one list. Code that only makes sense for rays asks [`Workload::is_point_query`] first.
 //!
 //! Primary and random rays come from the view and the bounds. Shadow and diffuse rays are
 //! secondary: they start on the surfaces the primary rays hit, so the caller traces the primary
@@ -24,13 +28,14 @@
 
 use crate::SceneError;
 use crate::View;
+use crate::points::PointWorkload;
 use crate::rng::{self, DIFFUSE_RAYS_STREAM, RANDOM_RAYS_STREAM};
 use raybench_geom::{Aabb, Ray, TriangleMesh, Vec3};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
-/// What a batch of rays asks of a structure.
+/// What a batch of queries asks of a structure: rays, or closest points.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Workload {
@@ -39,15 +44,36 @@ pub enum Workload {
     Shadow,
     Diffuse,
     Whitted,
+    /// Closest point, points near the surface ([`PointWorkload::Near`]).
+    #[serde(rename = "points-near")]
+    PointsNear,
+    /// Closest point, points in the enlarged box ([`PointWorkload::Volume`]).
+    #[serde(rename = "points-volume")]
+    PointsVolume,
 }
 
 impl Workload {
-    pub const ALL: [Workload; 5] = [
+    /// The ray workloads.
+    pub const RAYS: [Workload; 5] = [
         Workload::Primary,
         Workload::Random,
         Workload::Shadow,
         Workload::Diffuse,
         Workload::Whitted,
+    ];
+
+    /// The closest-point workloads.
+    pub const POINTS: [Workload; 2] = [Workload::PointsNear, Workload::PointsVolume];
+
+    /// Every workload: the rays, then the points.
+    pub const ALL: [Workload; 7] = [
+        Workload::Primary,
+        Workload::Random,
+        Workload::Shadow,
+        Workload::Diffuse,
+        Workload::Whitted,
+        Workload::PointsNear,
+        Workload::PointsVolume,
     ];
 
     pub fn name(&self) -> &'static str {
@@ -57,7 +83,23 @@ impl Workload {
             Workload::Shadow => "shadow",
             Workload::Diffuse => "diffuse",
             Workload::Whitted => "whitted",
+            Workload::PointsNear => PointWorkload::Near.name(),
+            Workload::PointsVolume => PointWorkload::Volume.name(),
         }
+    }
+
+    /// The closest-point workload this is, if it is one.
+    pub fn point_workload(&self) -> Option<PointWorkload> {
+        match self {
+            Workload::PointsNear => Some(PointWorkload::Near),
+            Workload::PointsVolume => Some(PointWorkload::Volume),
+            _ => None,
+        }
+    }
+
+    /// True for closest-point workloads (points, not rays).
+    pub fn is_point_query(&self) -> bool {
+        self.point_workload().is_some()
     }
 
     /// True when the query is "is anything in the way" (`occluded`), not the closest hit.
@@ -90,6 +132,9 @@ impl Workload {
             Workload::Whitted => {
                 "Whitted's recursion from primary hits: mirror reflections, and refractions through transparent materials, until a maximum depth or a minimum contribution: closest hit"
             }
+            Workload::PointsNear | Workload::PointsVolume => self
+                .point_workload()
+                .map_or("", |p| p.description()),
         }
     }
 }
@@ -579,5 +624,15 @@ mod tests {
         }
         let err = "glossy".parse::<Workload>().unwrap_err().to_string();
         assert!(err.contains("glossy") && err.contains("diffuse"), "{err}");
+        let points: Vec<Workload> = Workload::ALL
+            .into_iter()
+            .filter(Workload::is_point_query)
+            .collect();
+        assert_eq!(points, Workload::POINTS);
+        assert!(Workload::RAYS.iter().all(|w| w.point_workload().is_none()));
+        assert_eq!(
+            Workload::PointsVolume.point_workload(),
+            Some(PointWorkload::Volume)
+        );
     }
 }

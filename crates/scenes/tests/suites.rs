@@ -63,7 +63,21 @@ fn small_suites_generate_every_scene_with_its_view() {
         }
     }
     let (_, ci) = repository_suite("ci.json");
-    assert_eq!(ci.workloads, Workload::ALL, "ci runs every workload");
+    assert_eq!(
+        ci.workloads[..5],
+        Workload::RAYS,
+        "ci runs every ray workload"
+    );
+    assert_eq!(ci.workloads[5..], [Workload::PointsNear]);
+    assert_eq!(ci.points, Some(2_000), "a ci point workload stays quick");
+    for file in ["default.json", "full.json"] {
+        let (_, suite) = repository_suite(file);
+        assert!(
+            Workload::POINTS.iter().all(|w| suite.workloads.contains(w)),
+            "{file} runs both point workloads"
+        );
+        assert_eq!(suite.points, Some(10_000), "{file}");
+    }
     assert_eq!(ci.structures[0], "bruteforce");
 }
 
@@ -191,6 +205,11 @@ fn bad_manifests_are_errors_that_name_the_file() {
             "zero_rays.json",
             manifest("[\"sphere\"]").replace(": 10}", ": 0}"),
             "rays = 0",
+        ),
+        (
+            "zero_points.json",
+            manifest("[\"sphere\"]").replace(": 10}", ": 10, \"points\": 0}"),
+            "points = 0",
         ),
         (
             "not_json.json",

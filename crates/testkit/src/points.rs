@@ -32,11 +32,8 @@ use std::sync::Arc;
 pub const SEED_POINTS_NEAR: u64 = 0x5eed_7001;
 pub const SEED_POINTS_VOLUME: u64 = 0x5eed_7002;
 
-/// Tolerance in f32 ulps (machine epsilon times the largest |coordinate| of the mesh and the
-/// point). `closest_point_on_triangle` is within one ulp of the f64 reference (geom's
-/// dense-sampling test measures 0.63), and the f32 distance adds about one more; 8 leaves room
-/// without hiding a wrong triangle.
-pub const TOLERANCE_ULPS: f64 = 8.0;
+/// Tolerance in f32 ulps (see [`raybench_accel::compare_points::POINT_TOLERANCE_ULPS`]).
+pub const TOLERANCE_ULPS: f64 = raybench_accel::compare_points::POINT_TOLERANCE_ULPS;
 
 /// A mesh, the query points and the radii to ask them with.
 #[derive(Clone, Debug)]
@@ -184,16 +181,10 @@ pub fn exact_distance(p: Vec3, tri: &Triangle) -> f64 {
     distance_to_triangle_f64(p, tri)
 }
 
-/// Absolute distance tolerance for queries at `p` on `mesh`: [`TOLERANCE_ULPS`] f32 ulps of
-/// the largest coordinate magnitude involved (with a floor for scenes at the origin's scale).
+/// Absolute distance tolerance for queries at `p` on `mesh` (shared with the harness: see
+/// [`raybench_accel::compare_points::point_tolerance`]).
 pub fn tolerance(mesh_bounds: &Aabb, p: Vec3) -> f64 {
-    let mut scale = p.abs().max_element() as f64;
-    if !mesh_bounds.is_empty() {
-        scale = scale
-            .max(mesh_bounds.min.abs().max_element() as f64)
-            .max(mesh_bounds.max.abs().max_element() as f64);
-    }
-    TOLERANCE_ULPS * f32::EPSILON as f64 * scale.max(f32::MIN_POSITIVE as f64)
+    raybench_accel::compare_points::point_tolerance(mesh_bounds, p)
 }
 
 /// The checks one answer must pass on its own, whatever brute force says.
@@ -235,7 +226,9 @@ fn check_answer(
     Ok(())
 }
 
-/// Classifies `ours` against brute force's `expected` (see the module documentation).
+/// Classifies `ours` against brute force's `expected` (see the module documentation; the
+/// rule itself is [`raybench_accel::compare_points::classify_point`], which the harness uses
+/// against Embree).
 pub fn classify_point(
     mesh: &TriangleMesh,
     p: Vec3,
@@ -244,31 +237,14 @@ pub fn classify_point(
     expected: Option<PointHit>,
     tol: f64,
 ) -> PointVerdict {
-    match (ours, expected) {
-        (None, None) => PointVerdict::BothNone,
-        (Some(h), None) | (None, Some(h)) => {
-            if (h.distance as f64 - radius as f64).abs() <= tol {
-                PointVerdict::Boundary
-            } else {
-                PointVerdict::Mismatch
-            }
-        }
-        (Some(a), Some(b)) if a == b => PointVerdict::Exact,
-        (Some(a), Some(b)) => {
-            if (a.distance as f64 - b.distance as f64).abs() > tol {
-                PointVerdict::Mismatch
-            } else if a.prim == b.prim {
-                PointVerdict::WithinTolerance
-            } else {
-                let da = exact_distance(p, &mesh.triangle(a.prim as usize));
-                let db = exact_distance(p, &mesh.triangle(b.prim as usize));
-                if (da - db).abs() <= tol {
-                    PointVerdict::Tie
-                } else {
-                    PointVerdict::Mismatch
-                }
-            }
-        }
+    use raybench_accel::compare::Verdict;
+    match raybench_accel::compare_points::classify_point(mesh, p, radius, ours, expected, tol) {
+        Verdict::BothMiss => PointVerdict::BothNone,
+        Verdict::Exact => PointVerdict::Exact,
+        Verdict::WithinTolerance => PointVerdict::WithinTolerance,
+        Verdict::Tie => PointVerdict::Tie,
+        Verdict::Boundary => PointVerdict::Boundary,
+        Verdict::EdgeAmbiguous | Verdict::Mismatch => PointVerdict::Mismatch,
     }
 }
 

@@ -81,7 +81,8 @@ fn results_table(s: &mut String, report: &Report) {
                 <th>triangles</th><th>build ms (× ref)</th><th>bytes / triangle</th><th>SAH</th>",
     );
     for w in &workloads {
-        let _ = write!(s, "<th>{} Mrays/s (× ref)</th>", escape(w));
+        let unit = crate::report::throughput_unit(w);
+        let _ = write!(s, "<th>{} {unit} (× ref)</th>", escape(w));
     }
     s.push_str("<th>mismatches</th></tr>\n");
     for scene in scene_names(report) {

@@ -1,7 +1,7 @@
 //! `raybench report`: charts, pictures and one static HTML page, drawn from `report.json` alone.
 //!
 //! Output layout under the chosen directory:
-//! * `charts/*.svg` — build time, Mrays/s and ratios to the reference per workload, memory per
+//! * `charts/*.svg` — build time, Mrays/s (Mqueries/s for closest-point workloads) and ratios to the reference per workload, memory per
 //!   triangle, counters per ray, scaling curves with reference slopes (when one scene family
 //!   comes in three or more sizes), break-even per scene, validation classes;
 //! * `images/*.png` — per scene and structure: traversal-cost heatmap (one colour scale per
@@ -14,7 +14,7 @@ pub mod charts;
 mod html;
 pub mod pictures;
 
-use crate::report::{Report, ResultEntry};
+use crate::report::{Report, ResultEntry, throughput_unit};
 use anyhow::{Context, Result};
 use charts::{Bars, LogLog, Series};
 use std::path::{Path, PathBuf};
@@ -67,17 +67,8 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
     Ok(out)
 }
 
-/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path)
-        .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
-}
+/// Kept at this path for its callers; the one implementation is in [`crate::atomic`].
+pub use crate::atomic::write_atomic;
 
 /// A file-name-safe form of a name: lower-case letters and digits, everything else `-`
 /// (`teapot.obj` → `teapot-obj`, so it never meets the generator `teapot`).
@@ -221,13 +212,15 @@ pub fn all_charts(report: &Report) -> Result<Vec<(String, String, String)>> {
     )?;
     for wl in workload_names(report) {
         let find = |r: &ResultEntry| r.workloads.iter().find(|w| w.workload == wl).cloned();
+        // Closest-point workloads count queries: same charts, their own unit.
+        let unit = throughput_unit(&wl);
         push(
             format!("mrays-{}.svg", slug(&wl)),
-            format!("Throughput on `{wl}` (median Mrays/s), log scale"),
+            format!("Throughput on `{wl}` (median {unit}), log scale"),
             &bars(
                 report,
-                format!("{wl}: Mrays/s"),
-                "Mrays/s (median)",
+                format!("{wl}: {unit}"),
+                &format!("{unit} (median)"),
                 true,
                 |r| find(r).map(|w| w.mrays_per_s.median),
             ),
@@ -239,7 +232,7 @@ pub fn all_charts(report: &Report) -> Result<Vec<(String, String, String)>> {
             ),
             &bars(
                 report,
-                format!("{wl}: Mrays/s / {reference}"),
+                format!("{wl}: {unit} / {reference}"),
                 "ratio",
                 true,
                 |r| find(r).and_then(|w| w.speedup_vs_reference),

@@ -4,15 +4,16 @@
 use raybench_harness::run::RunOptions;
 use raybench_scenes::Workload;
 
-/// A quick, explicit run: every workload, 3000 rays, one thread, one build and one trace pass,
+/// A quick, explicit run: every ray workload, 3000 rays (500 points if a test adds a point workload), one thread, one build and one trace pass,
 /// against embree-medium. Tests override what they need with struct update syntax.
 pub fn options(structures: &[&str]) -> RunOptions {
     RunOptions {
         suite: None,
         scenes: vec![],
         structures: structures.iter().map(|s| s.to_string()).collect(),
-        workloads: Workload::ALL.to_vec(),
+        workloads: Workload::RAYS.to_vec(),
         rays: 3000,
+        points: 500,
         threads: 1,
         reference: "embree-medium".into(),
         seed: 7,
@@ -21,5 +22,6 @@ pub fn options(structures: &[&str]) -> RunOptions {
         ftz_daz: false,
         progress: false,
         images: true,
+        dump_hits: None,
     }
 }
