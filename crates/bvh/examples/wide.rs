@@ -36,7 +36,9 @@ fn best(v: &[f64]) -> f64 {
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let path = args.next().unwrap_or("../shared/scenes/stanford-bunny.obj".into());
+    let path = args
+        .next()
+        .unwrap_or("../shared/scenes/stanford-bunny.obj".into());
     let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(50_000);
     let rounds: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);
     let only = args.next(); // one workload's name, to profile it alone

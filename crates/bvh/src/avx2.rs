@@ -59,7 +59,10 @@ fn test8(r: &Avx2Ray, n: &Node8, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) 
                 _mm256_loadu_ps(far.as_ptr().cast()),
             )
         };
-        t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, r.origin[a]), r.inv[a]), t0);
+        t0 = _mm256_max_ps(
+            _mm256_mul_ps(_mm256_sub_ps(near, r.origin[a]), r.inv[a]),
+            t0,
+        );
         t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, r.origin[a]), r.inv[a]), t1);
     }
     let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32;

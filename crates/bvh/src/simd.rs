@@ -248,7 +248,9 @@ mod imp {
         }
         #[inline(always)]
         fn mask(f: impl Fn(usize) -> bool) -> F4 {
-            F4(std::array::from_fn(|i| f32::from_bits(if f(i) { u32::MAX } else { 0 })))
+            F4(std::array::from_fn(|i| {
+                f32::from_bits(if f(i) { u32::MAX } else { 0 })
+            }))
         }
         #[inline(always)]
         pub fn lt(self, o: F4) -> F4 {
@@ -268,7 +270,9 @@ mod imp {
         }
         #[inline(always)]
         pub fn and(self, o: F4) -> F4 {
-            F4(std::array::from_fn(|i| f32::from_bits(self.0[i].to_bits() & o.0[i].to_bits())))
+            F4(std::array::from_fn(|i| {
+                f32::from_bits(self.0[i].to_bits() & o.0[i].to_bits())
+            }))
         }
         #[inline(always)]
         pub fn bits(self) -> u32 {

@@ -212,8 +212,11 @@ mod tests {
                     MollerTriangle::new(&Triangle::new(v0, rng.point(1.0), v2))
                 })
                 .collect();
-            let ids: Vec<(u32, MollerTriangle)> =
-                tris.iter().enumerate().map(|(i, t)| (i as u32, *t)).collect();
+            let ids: Vec<(u32, MollerTriangle)> = tris
+                .iter()
+                .enumerate()
+                .map(|(i, t)| (i as u32, *t))
+                .collect();
             let packet = Tri4::pack(&ids);
             let origin = rng.point(3.0);
             // Aim near a point of one of the triangles (barycentric weights slightly beyond
@@ -249,7 +252,10 @@ mod tests {
                 assert_eq!(packet.ids[lane], lane as u32);
             }
         }
-        assert!(hits > 2_000, "only {hits} of 20000 rays hit: the test proves little");
+        assert!(
+            hits > 2_000,
+            "only {hits} of 20000 rays hit: the test proves little"
+        );
     }
 
     #[test]

@@ -146,7 +146,12 @@ pub struct Bvh8 {
 }
 
 /// Appends the packets of one binary leaf (mesh triangles `ids`) and returns its wide reference.
-fn pack_leaf(mesh: &TriangleMesh, ids: &[u32], packets: &mut Vec<Tri4>, lanes: &mut Vec<u32>) -> ChildRef {
+fn pack_leaf(
+    mesh: &TriangleMesh,
+    ids: &[u32],
+    packets: &mut Vec<Tri4>,
+    lanes: &mut Vec<u32>,
+) -> ChildRef {
     let index = packets.len() as u32;
     for chunk in ids.chunks(4) {
         let mut packet = Tri4::default();
@@ -790,7 +795,8 @@ impl Bvh8 {
             "packet_fill".into(),
             s.refs as f64 / (4 * self.packets.len()).max(1) as f64,
         );
-        s.extra.insert("avx2_node_test".into(), self.uses_avx2() as u8 as f64);
+        s.extra
+            .insert("avx2_node_test".into(), self.uses_avx2() as u8 as f64);
         s.nodes += s.leaves;
         s.sah_cost = (root_area > 0.0).then_some(sah);
         s

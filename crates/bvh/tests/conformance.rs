@@ -91,7 +91,10 @@ fn wide_sse_kernel_conforms_and_matches_the_default() {
     assert!(!b.uses_avx2());
     for ray in raybench_scenes::random_rays(&mesh.bounds(), 5_000, 7) {
         let (mut ca, mut cb) = (Counters::default(), Counters::default());
-        assert_eq!(a.intersect_counted(&ray, &mut ca), b.intersect_counted(&ray, &mut cb));
+        assert_eq!(
+            a.intersect_counted(&ray, &mut ca),
+            b.intersect_counted(&ray, &mut cb)
+        );
         assert_eq!(a.occluded(&ray), b.occluded(&ray));
         assert_eq!(ca, cb, "{ray:?}");
     }
@@ -147,8 +150,12 @@ fn wide_point_queries_conform() {
 #[test]
 fn point_queries_conform_on_the_shared_scenes() {
     use raybench_testkit::points::point_conformance_on_shared_scenes;
-    let binary =
-        point_conformance_on_shared_scenes::<Bvh>(&BvhParams::binned(), &|b, m| b.validate(m), 70, 30);
+    let binary = point_conformance_on_shared_scenes::<Bvh>(
+        &BvhParams::binned(),
+        &|b, m| b.validate(m),
+        70,
+        30,
+    );
     let wide = point_conformance_on_shared_scenes::<Bvh8>(
         &Bvh8Params::default(),
         &|b, m| b.validate(m),

@@ -46,7 +46,9 @@ pub enum SceneError {
     #[error("generator spec `{spec}`: {problem}")]
     Generator { spec: String, problem: String },
 
-    #[error("unknown workload `{name}` (known: primary, random, shadow, diffuse, whitted, points-near, points-volume)")]
+    #[error(
+        "unknown workload `{name}` (known: primary, random, shadow, diffuse, whitted, points-near, points-volume)"
+    )]
     UnknownWorkload { name: String },
 
     #[error("{}: not a valid suite manifest: {source}", .path.display())]

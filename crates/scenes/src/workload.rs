@@ -132,9 +132,9 @@ impl Workload {
             Workload::Whitted => {
                 "Whitted's recursion from primary hits: mirror reflections, and refractions through transparent materials, until a maximum depth or a minimum contribution: closest hit"
             }
-            Workload::PointsNear | Workload::PointsVolume => self
-                .point_workload()
-                .map_or("", |p| p.description()),
+            Workload::PointsNear | Workload::PointsVolume => {
+                self.point_workload().map_or("", |p| p.description())
+            }
         }
     }
 }

@@ -41,8 +41,7 @@ impl Split {
 /// areas: only their ratios matter.
 fn split_cost(p: &BvhParams, parent: f64, left: (f64, usize), right: (f64, usize)) -> f64 {
     p.traversal_cost as f64
-        + p.intersection_cost as f64
-            * (left.0 * blocks(p, left.1) + right.0 * blocks(p, right.1))
+        + p.intersection_cost as f64 * (left.0 * blocks(p, left.1) + right.0 * blocks(p, right.1))
             / parent
 }
 
