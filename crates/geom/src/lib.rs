@@ -17,6 +17,8 @@ mod aabb;
 mod mesh;
 mod point;
 mod ray;
+#[cfg(test)]
+mod test_rng;
 mod triangle;
 pub mod tribox;
 

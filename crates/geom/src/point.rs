@@ -149,24 +149,7 @@ fn segment_distance_f64(p: DVec3, s: DVec3, e: DVec3) -> f64 {
 mod tests {
     use super::*;
 
-    /// SplitMix64: a seeded stream without a dependency (geom has none for tests).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^ (z >> 31)
-        }
-        /// Uniform in [-1, 1).
-        fn signed(&mut self) -> f32 {
-            (self.next() >> 40) as f32 / (1u64 << 23) as f32 - 1.0
-        }
-        fn vec(&mut self) -> Vec3 {
-            Vec3::new(self.signed(), self.signed(), self.signed())
-        }
-    }
+    use crate::test_rng::SplitMix as Rng;
 
     /// The shapes the region method must survive, each a function of the stream.
     #[derive(Clone, Copy, Debug)]
@@ -200,12 +183,12 @@ mod tests {
     ];
 
     fn random_triangle(rng: &mut Rng, shape: Shape) -> Triangle {
-        let (a, b) = (rng.vec(), rng.vec());
+        let (a, b) = (rng.signed_vec(), rng.signed_vec());
         let c = match shape {
-            Shape::Thin => a.lerp(b, rng.signed() * 0.5 + 0.5) + rng.vec() * 1e-4,
+            Shape::Thin => a.lerp(b, rng.signed() * 0.5 + 0.5) + rng.signed_vec() * 1e-4,
             Shape::Collinear => a.lerp(b, rng.signed() * 1.5),
             Shape::RepeatedVertex => a,
-            _ => rng.vec(),
+            _ => rng.signed_vec(),
         };
         let t = Triangle::new(a, b, c);
         let (scale, offset) = match shape {
@@ -225,7 +208,7 @@ mod tests {
     fn random_query(rng: &mut Rng, t: &Triangle) -> Vec3 {
         let b = t.bounds();
         let size = b.diagonal().max(1e-6 * b.max.abs().max_element().max(1.0));
-        let near = b.center() + rng.vec() * size;
+        let near = b.center() + rng.signed_vec() * size;
         if rng.next().is_multiple_of(4) {
             // Exactly in the plane of (v0, v1): the in-plane regions, where signs are closest to 0.
             t.v0 + (t.v1 - t.v0) * (rng.signed() * 2.0) + (t.v2 - t.v0) * rng.signed()
@@ -379,7 +362,7 @@ mod tests {
         for shape in SHAPES {
             for _ in 0..500 {
                 let t = random_triangle(&mut rng, shape);
-                let p = random_query(&mut rng, &t) + rng.vec() * t.bounds().diagonal();
+                let p = random_query(&mut rng, &t) + rng.signed_vec() * t.bounds().diagonal();
                 let boxed = box_distance_squared(p, &t.bounds()) as f64;
                 let exact = distance_to_triangle_f64(p, &t);
                 assert!(

@@ -184,24 +184,7 @@ mod tests {
     use super::*;
     use glam::Vec3;
 
-    /// splitmix64: geom has no RNG dependency and needs none beyond this.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^ (z >> 31)
-        }
-        /// Uniform in [0, 1).
-        fn f(&mut self) -> f32 {
-            (self.next() >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn v(&mut self) -> Vec3 {
-            Vec3::new(self.f(), self.f(), self.f())
-        }
-    }
+    use crate::test_rng::SplitMix as Rng;
 
     fn t(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> Triangle {
         Triangle::new(a.into(), b.into(), c.into())
@@ -276,15 +259,15 @@ mod tests {
         let mut rng = Rng(0x5eed_7b0c);
         let (mut hits, mut misses) = (0, 0);
         for case in 0..100_000 {
-            let lo = rng.v() * 2.0 - 1.0;
-            let hi = lo + rng.v() * 0.8 + 0.01;
+            let lo = rng.unit_vec() * 2.0 - 1.0;
+            let hi = lo + rng.unit_vec() * 0.8 + 0.01;
             let size = [0.05f32, 0.3, 1.5][case % 3];
             // Centred around the box, from well inside to well outside it.
-            let c = lo + (hi - lo) * (rng.v() * 2.0 - 0.5) + (rng.v() - 0.5) * size;
+            let c = lo + (hi - lo) * (rng.unit_vec() * 2.0 - 0.5) + (rng.unit_vec() - 0.5) * size;
             let tri = Triangle::new(
-                c + (rng.v() - 0.5) * size,
-                c + (rng.v() - 0.5) * size,
-                c + (rng.v() - 0.5) * size,
+                c + (rng.unit_vec() - 0.5) * size,
+                c + (rng.unit_vec() - 0.5) * size,
+                c + (rng.unit_vec() - 0.5) * size,
             );
             let (blo, bhi) = (lo.as_dvec3(), hi.as_dvec3());
             let sat = ov(&tri, (blo, bhi));
@@ -317,8 +300,8 @@ mod tests {
         let (mut hits, mut misses) = (0, 0);
         for case in 0..50_000 {
             let (blo, bhi) = unit();
-            let a = rng.v() * 3.0 - 1.0;
-            let b = rng.v() * 3.0 - 1.0;
+            let a = rng.unit_vec() * 3.0 - 1.0;
+            let b = rng.unit_vec() * 3.0 - 1.0;
             let tri = match case % 3 {
                 0 => Triangle::new(a, a, a),                 // point
                 1 => Triangle::new(a, b, b),                 // segment (repeated vertex)
@@ -481,13 +464,13 @@ mod tests {
     fn scale_invariant_from_tiny_to_huge() {
         let mut rng = Rng(0x5eed_5ca1);
         for case in 0..20_000 {
-            let lo = rng.v() * 2.0 - 1.0;
-            let hi = lo + rng.v() * 0.5;
-            let c = rng.v() * 2.0 - 1.0;
+            let lo = rng.unit_vec() * 2.0 - 1.0;
+            let hi = lo + rng.unit_vec() * 0.5;
+            let c = rng.unit_vec() * 2.0 - 1.0;
             let tri = Triangle::new(
-                c + (rng.v() - 0.5) * 0.7,
-                c + (rng.v() - 0.5) * 0.7,
-                c + (rng.v() - 0.5) * 0.7,
+                c + (rng.unit_vec() - 0.5) * 0.7,
+                c + (rng.unit_vec() - 0.5) * 0.7,
+                c + (rng.unit_vec() - 0.5) * 0.7,
             );
             let base = ov(&tri, (lo.as_dvec3(), hi.as_dvec3()));
             for k in [-60i32, 60] {
@@ -539,12 +522,12 @@ mod tests {
         let mut both = [0usize; 2];
         for case in 0..30_000 {
             let axis = case % 3;
-            let lo = rng.v() * 2.0 - 1.0;
-            let hi = lo + rng.v() * 0.6 + 0.01;
-            let c = lo + (hi - lo) * (rng.v() * 2.0 - 0.5);
-            let mut v = [0; 3].map(|_| c + (rng.v() - 0.5) * 0.8);
+            let lo = rng.unit_vec() * 2.0 - 1.0;
+            let hi = lo + rng.unit_vec() * 0.6 + 0.01;
+            let c = lo + (hi - lo) * (rng.unit_vec() * 2.0 - 0.5);
+            let mut v = [0; 3].map(|_| c + (rng.unit_vec() - 0.5) * 0.8);
             for p in &mut v {
-                p[axis] = lo[axis] + (hi[axis] - lo[axis]) * rng.f();
+                p[axis] = lo[axis] + (hi[axis] - lo[axis]) * rng.unit();
             }
             let tb = TriBox::new(&Triangle::new(v[0], v[1], v[2]));
             let (blo, bhi) = (lo.as_dvec3(), hi.as_dvec3());

@@ -217,23 +217,7 @@ pub fn edge_cases() -> Vec<Case> {
     }
 
     // Every triangle with the same centroid (concentric, rotated): degenerate SAH input (B5).
-    let concentric: Vec<Triangle> = (0..300)
-        .map(|i| {
-            let r = 0.01 + i as f32 * 0.01;
-            let a = i as f32 * 0.37;
-            let p = |k: f32| {
-                Vec3::new(
-                    (a + k).cos() * r,
-                    (a + k).sin() * r,
-                    ((a + k) * 3.0).sin() * r * 0.3,
-                )
-            };
-            let (p0, p1, p2) = (p(0.0), p(2.1), p(4.2));
-            let c = (p0 + p1 + p2) / 3.0;
-            Triangle::new(p0 - c, p1 - c, p2 - c)
-        })
-        .collect();
-    let m = from_tris(&concentric);
+    let m = from_tris(&concentric_triangles());
     cases.push(Case::new(
         "one-centroid",
         s,
@@ -574,6 +558,27 @@ pub fn lattice_scene() -> Arc<TriangleMesh> {
         tris.push(Triangle::new(v(), v(), v()));
     }
     Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0)
+}
+
+/// 300 triangles of growing size, rotated, every one centred exactly on the origin: the
+/// one-centroid input (bug class B5) of the ray and the point conformance suites.
+pub(crate) fn concentric_triangles() -> Vec<Triangle> {
+    (0..300)
+        .map(|i| {
+            let r = 0.01 + i as f32 * 0.01;
+            let a = i as f32 * 0.37;
+            let p = |k: f32| {
+                Vec3::new(
+                    (a + k).cos() * r,
+                    (a + k).sin() * r,
+                    ((a + k) * 3.0).sin() * r * 0.3,
+                )
+            };
+            let (p0, p1, p2) = (p(0.0), p(2.1), p(4.2));
+            let c = (p0 + p1 + p2) / 3.0;
+            Triangle::new(p0 - c, p1 - c, p2 - c)
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -160,19 +160,9 @@ pub fn conformance_on_shared_scenes<A: Accel>(
     params: &A::Params,
     validate: Validator<'_, A>,
 ) -> usize {
-    let dir = shared_scenes_dir();
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!(
-            "NOT RUN: {} is absent, so the real-scene conformance check did not run",
-            dir.display()
-        );
+    let Some(files) = shared_obj_files("real-scene conformance check") else {
         return 0;
     };
-    let mut files: Vec<_> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
-        .collect();
-    files.sort();
     for path in &files {
         let scene = raybench_scenes::load_obj(path).unwrap_or_else(|e| panic!("{e}"));
         let seed = 0x5eed_0005;
@@ -192,4 +182,23 @@ pub fn conformance_on_shared_scenes<A: Accel>(
         );
     }
     files.len()
+}
+
+/// The `.obj` files of [`shared_scenes_dir`], sorted; `None` — after saying plainly on stderr
+/// that `check` did not run — when the folder is absent (a fresh clone without ../shared).
+pub fn shared_obj_files(check: &str) -> Option<Vec<std::path::PathBuf>> {
+    let dir = shared_scenes_dir();
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        eprintln!(
+            "NOT RUN: {} is absent, so the {check} did not run",
+            dir.display()
+        );
+        return None;
+    };
+    let mut files: Vec<_> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .collect();
+    files.sort();
+    Some(files)
 }

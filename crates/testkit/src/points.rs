@@ -336,19 +336,9 @@ pub fn point_conformance_on_shared_scenes<A: Accel>(
     near: usize,
     volume: usize,
 ) -> usize {
-    let dir = crate::shared_scenes_dir();
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!(
-            "NOT RUN: {} is absent, so the real-scene point check did not run",
-            dir.display()
-        );
+    let Some(files) = crate::shared_obj_files("real-scene point check") else {
         return 0;
     };
-    let mut files: Vec<_> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
-        .collect();
-    files.sort();
     for path in &files {
         let mesh = raybench_scenes::load_obj(path)
             .unwrap_or_else(|e| panic!("{e}"))
@@ -574,22 +564,7 @@ pub fn edge_point_cases() -> Vec<PointCase> {
 /// Concentric triangles sharing one centroid (degenerate input for every splitting rule), with
 /// the centroid itself among the points.
 fn one_centroid_case() -> PointCase {
-    let tris: Vec<Triangle> = (0..300)
-        .map(|i| {
-            let r = 0.01 + i as f32 * 0.01;
-            let a = i as f32 * 0.37;
-            let p = |k: f32| {
-                Vec3::new(
-                    (a + k).cos() * r,
-                    (a + k).sin() * r,
-                    ((a + k) * 3.0).sin() * r * 0.3,
-                )
-            };
-            let (p0, p1, p2) = (p(0.0), p(2.1), p(4.2));
-            let c = (p0 + p1 + p2) / 3.0;
-            Triangle::new(p0 - c, p1 - c, p2 - c)
-        })
-        .collect();
+    let tris = crate::cases::concentric_triangles();
     let m = from_tris(&tris);
     let mut points = mixed_points(&m, 500, SEED_EDGE);
     points.push(Vec3::ZERO);
