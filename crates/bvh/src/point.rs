@@ -125,7 +125,6 @@ pub(crate) struct WideView<'a> {
     pub root_bounds: &'a Aabb,
     pub nodes: &'a [Node8],
     pub packets: &'a [Tri4],
-    pub prim_ids: &'a [u32],
     pub mesh: &'a TriangleMesh,
 }
 
@@ -232,7 +231,7 @@ fn wide_leaf<C: CounterSink>(
     let first = 4 * r.index as usize;
     for slot in first..first + r.count as usize {
         c.prim_tests(1);
-        let prim = bvh.prim_ids[slot];
+        let prim = bvh.packets[slot / 4].ids[slot % 4];
         nearest.test_triangle(p, prim, &bvh.mesh.triangle(prim as usize));
     }
 }

@@ -135,10 +135,8 @@ pub struct Bvh8 {
     nodes: Vec<Node8>,
     root: ChildRef,
     root_bounds: Aabb,
+    /// Leaf triangles, four to a packet, each lane with its mesh index ([`NO_PRIM`] unused).
     packets: Vec<Tri4>,
-    /// Mesh index of every packet lane (`4 * packet + lane`), [`NO_PRIM`] for unused lanes:
-    /// the packets' ids in one array, for validation and the closest-point walk.
-    prim_ids: Vec<u32>,
     /// The mesh as built, for closest-point queries (exact vertices).
     mesh: Arc<TriangleMesh>,
     #[cfg(target_arch = "x86_64")]
@@ -146,12 +144,7 @@ pub struct Bvh8 {
 }
 
 /// Appends the packets of one binary leaf (mesh triangles `ids`) and returns its wide reference.
-fn pack_leaf(
-    mesh: &TriangleMesh,
-    ids: &[u32],
-    packets: &mut Vec<Tri4>,
-    lanes: &mut Vec<u32>,
-) -> ChildRef {
+fn pack_leaf(mesh: &TriangleMesh, ids: &[u32], packets: &mut Vec<Tri4>) -> ChildRef {
     let index = packets.len() as u32;
     for chunk in ids.chunks(4) {
         let mut packet = Tri4::default();
@@ -159,8 +152,6 @@ fn pack_leaf(
             packet.set_lane(lane, i, &MollerTriangle::new(&mesh.triangle(i as usize)));
         }
         packets.push(packet);
-        lanes.extend(chunk);
-        lanes.extend(std::iter::repeat_n(NO_PRIM, 4 - chunk.len()));
     }
     ChildRef {
         index,
@@ -226,13 +217,18 @@ impl Bvh8 {
             root_bounds: &self.root_bounds,
             nodes: &self.nodes,
             packets: &self.packets,
-            prim_ids: &self.prim_ids,
             mesh: &self.mesh,
         }
     }
 
     pub fn params(&self) -> &Bvh8Params {
         &self.params
+    }
+
+    /// The mesh index of every packet lane in order (`4 * packet + lane`), [`NO_PRIM`] for
+    /// unused lanes.
+    fn lane_ids(&self) -> impl Iterator<Item = u32> + '_ {
+        self.packets.iter().flat_map(|p| p.ids)
     }
 
     /// Whether nodes are tested with the AVX2 kernel (else SSE).
@@ -248,13 +244,6 @@ impl Bvh8 {
     /// triangle; every mesh triangle exactly once; depth within the stack bound.
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         let n = mesh.len();
-        if self.prim_ids.len() != 4 * self.packets.len() {
-            return Err(format!(
-                "{} lane ids for {} packets",
-                self.prim_ids.len(),
-                self.packets.len()
-            ));
-        }
         self.check_lanes(mesh)?;
         if n == 0 {
             return Ok(());
@@ -282,11 +271,8 @@ impl Bvh8 {
     /// unused lanes are the all-zero triangle.
     fn check_lanes(&self, mesh: &TriangleMesh) -> Result<(), String> {
         let mut seen = vec![false; mesh.len()];
-        for (slot, &id) in self.prim_ids.iter().enumerate() {
+        for (slot, id) in self.lane_ids().enumerate() {
             let lane = self.packets[slot / 4].lane(slot % 4);
-            if id != self.packets[slot / 4].ids[slot % 4] {
-                return Err(format!("lane {slot}: packet id differs from {id}"));
-            }
             if id == NO_PRIM {
                 if lane != Tri4::default().lane(0) {
                     return Err(format!("unused lane {slot} holds a triangle"));
@@ -370,12 +356,12 @@ impl Bvh8 {
             return Err(format!("leaf at packet {}, expected {covered}", r.index));
         }
         let packets = (r.count as usize).div_ceil(4);
-        let first = 4 * r.index as usize;
-        let lanes = self
-            .prim_ids
-            .get(first..first + 4 * packets)
+        let first = r.index as usize;
+        let leaf = self
+            .packets
+            .get(first..first + packets)
             .ok_or("leaf runs past the packets")?;
-        for (k, &id) in lanes.iter().enumerate() {
+        for (k, &id) in leaf.iter().flat_map(|p| &p.ids).enumerate() {
             if (k < r.count as usize) != (id != NO_PRIM) {
                 return Err(format!("leaf at packet {} has lane {k} misused", r.index));
             }
@@ -527,7 +513,7 @@ fn nearest_first(
 }
 
 /// Tests the packets of leaf `r` below `*best_t`, keeping the closest hit (as a lane index
-/// into [`Bvh8::prim_ids`]); true when an any-hit query may stop.
+/// `4 * packet + lane`); true when an any-hit query may stop.
 #[inline(always)]
 fn intersect_packets<const ANY_HIT: bool, C: CounterSink>(
     packets: &[Tri4],
@@ -657,13 +643,12 @@ impl Accel for Bvh8 {
         let flat = build::build(&mesh, &params.binary)?;
         let mut nodes = Vec::with_capacity(flat.nodes.len() / 3 + 1);
         let mut packets = Vec::with_capacity(flat.prim_ids.len() / 2 + 1);
-        let mut prim_ids = Vec::with_capacity(flat.prim_ids.len() * 2 + 4);
         let root = if flat.prim_ids.is_empty() {
             ChildRef::default()
         } else {
             collapse(&flat.nodes, flat.root, &mut nodes, &mut |r| {
                 let ids = &flat.prim_ids[r.index as usize..(r.index + r.count) as usize];
-                pack_leaf(&mesh, ids, &mut packets, &mut prim_ids)
+                pack_leaf(&mesh, ids, &mut packets)
             })
         };
         Ok(Bvh8 {
@@ -672,7 +657,6 @@ impl Accel for Bvh8 {
             root,
             root_bounds: flat.root_bounds,
             packets,
-            prim_ids,
             mesh,
             #[cfg(target_arch = "x86_64")]
             avx2: match params.node_simd {
@@ -744,7 +728,8 @@ impl Accel for Bvh8 {
     fn memory(&self) -> Memory {
         Memory {
             nodes: std::mem::size_of_val(self.nodes.as_slice()) as u64,
-            indices: std::mem::size_of_val(self.prim_ids.as_slice()) as u64,
+            // Triangle ids live in the packets.
+            indices: 0,
             primitives: std::mem::size_of_val(self.packets.as_slice()) as u64,
         }
     }
