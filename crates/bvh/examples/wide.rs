@@ -1,4 +1,4 @@
-//! Times the 8-wide BVH next to embree-medium on one scene, outside the harness, for quick
+//! Times the wide BVHs (4 and 8 children) next to embree-medium on one scene, outside the harness, for quick
 //! before/after checks of traversal changes on a shared, noisy machine: each round times every
 //! structure once per workload, interleaved, and the figures printed are each structure's best
 //! pass (the one least disturbed by other processes) and its ratio to Embree's best pass.
@@ -8,7 +8,7 @@
 //! (scene, rays per workload, rounds, optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round.
 
 use raybench_accel::{Accel, PreparedRays};
-use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams, NodeSimd};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, NodeSimd, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
 use raybench_scenes::SurfaceHit;
@@ -57,6 +57,9 @@ fn main() {
     });
     add("bvh-binned", &|| {
         Box::new(Bvh::build(Arc::clone(&mesh), &BvhParams::binned()).expect("builds"))
+    });
+    add("bvh4", &|| {
+        Box::new(Bvh4::build(Arc::clone(&mesh), &WideParams::for_width(4)).expect("builds"))
     });
     add("bvh8", &|| {
         Box::new(Bvh8::build(Arc::clone(&mesh), &Bvh8Params::default()).expect("builds"))

@@ -8,7 +8,7 @@
 //! AVX-512 adds nothing for 8 lanes of f32 that AVX2 lacks here (the mask compare into `k`
 //! registers saves one `movemask`), so it is not a separate kernel.
 
-use crate::wide::{Bvh8, Node8, NodeKernel, Stack, WIDTH};
+use crate::wide::{BvhWide, NodeKernel, Stack, WideNode};
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::Ray;
 use std::arch::x86_64::*;
@@ -43,36 +43,53 @@ fn splat_ray(ray: &Ray) -> Avx2Ray {
     }
 }
 
+/// The eight lanes `8 * o ..` of a plane row, for one AVX load.
+#[inline(always)]
+fn oct<const W: usize>(row: &[f32; W], o: usize) -> &[f32; 8] {
+    &row.as_chunks::<8>().0[o]
+}
+
+/// One pass per axis and eight children (a width that is not a multiple of 8 never gets
+/// this kernel: see [`BvhWide`]'s build).
 #[target_feature(enable = "avx2")]
 #[inline]
-fn test8(r: &Avx2Ray, n: &Node8, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
-    let mut t0 = _mm256_set1_ps(t_min);
-    let mut t1 = _mm256_set1_ps(t_max);
-    for a in 0..3 {
-        let near: &[[f32; 4]; 2] = &n.planes[a][r.near[a] as usize];
-        let far: &[[f32; 4]; 2] = &n.planes[a][!r.near[a] as usize];
-        // SAFETY: each is a reference to 8 contiguous initialised f32s (`[[f32; 4]; 2]`),
-        // and `loadu` has no alignment requirement.
-        let (near, far) = unsafe {
-            (
-                _mm256_loadu_ps(near.as_ptr().cast()),
-                _mm256_loadu_ps(far.as_ptr().cast()),
-            )
-        };
-        t0 = _mm256_max_ps(
-            _mm256_mul_ps(_mm256_sub_ps(near, r.origin[a]), r.inv[a]),
-            t0,
-        );
-        t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, r.origin[a]), r.inv[a]), t1);
+fn test_octs<const W: usize>(
+    r: &Avx2Ray,
+    n: &WideNode<W>,
+    t_min: f32,
+    t_max: f32,
+) -> (u32, [f32; W]) {
+    let mut mask = 0;
+    let mut entry = [0.0f32; W];
+    for o in 0..W / 8 {
+        let mut t0 = _mm256_set1_ps(t_min);
+        let mut t1 = _mm256_set1_ps(t_max);
+        for a in 0..3 {
+            let near = oct(&n.planes[a][r.near[a] as usize], o);
+            let far = oct(&n.planes[a][!r.near[a] as usize], o);
+            // SAFETY: each is a reference to 8 contiguous initialised f32s, and `loadu` has
+            // no alignment requirement.
+            let (near, far) = unsafe {
+                (
+                    _mm256_loadu_ps(near.as_ptr()),
+                    _mm256_loadu_ps(far.as_ptr()),
+                )
+            };
+            t0 = _mm256_max_ps(
+                _mm256_mul_ps(_mm256_sub_ps(near, r.origin[a]), r.inv[a]),
+                t0,
+            );
+            t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, r.origin[a]), r.inv[a]), t1);
+        }
+        mask |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32) << (8 * o);
+        let out: &mut [f32; 8] = &mut entry.as_chunks_mut::<8>().0[o];
+        // SAFETY: `out` is 8 writable f32s; `storeu` has no alignment requirement.
+        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), t0) };
     }
-    let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32;
-    let mut entry = [0.0f32; WIDTH];
-    // SAFETY: `entry` is 8 writable f32s; `storeu` has no alignment requirement.
-    unsafe { _mm256_storeu_ps(entry.as_mut_ptr(), t0) };
     (mask, entry)
 }
 
-impl NodeKernel for Avx2Nodes {
+impl<const W: usize> NodeKernel<W> for Avx2Nodes {
     type Ray = Avx2Ray;
 
     #[inline(always)]
@@ -82,16 +99,16 @@ impl NodeKernel for Avx2Nodes {
     }
 
     #[inline(always)]
-    fn test(self, ray: &Avx2Ray, n: &Node8, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+    fn test(self, ray: &Avx2Ray, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]) {
         // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.
-        unsafe { test8(ray, n, t_min, t_max) }
+        unsafe { test_octs(ray, n, t_min, t_max) }
     }
 }
 
-/// [`Bvh8::walk_ray`] compiled for AVX2, so [`test8`] inlines into the loop.
+/// [`BvhWide::walk_ray`] compiled for AVX2, so [`test_octs`] inlines into the loop.
 #[target_feature(enable = "avx2")]
-fn walk_ray_avx2<const ANY_HIT: bool, C: CounterSink>(
-    bvh: &Bvh8,
+fn walk_ray_avx2<const W: usize, const ANY_HIT: bool, C: CounterSink>(
+    bvh: &BvhWide<W>,
     k: Avx2Nodes,
     ray: &Ray,
     stack: &mut Stack,
@@ -101,13 +118,13 @@ fn walk_ray_avx2<const ANY_HIT: bool, C: CounterSink>(
 }
 
 #[inline(always)]
-pub(crate) fn walk_ray<const ANY_HIT: bool, C: CounterSink>(
-    bvh: &Bvh8,
+pub(crate) fn walk_ray<const W: usize, const ANY_HIT: bool, C: CounterSink>(
+    bvh: &BvhWide<W>,
     k: Avx2Nodes,
     ray: &Ray,
     stack: &mut Stack,
     c: &mut C,
 ) -> Option<Hit> {
     // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
-    unsafe { walk_ray_avx2::<ANY_HIT, C>(bvh, k, ray, stack, c) }
+    unsafe { walk_ray_avx2::<W, ANY_HIT, C>(bvh, k, ray, stack, c) }
 }

@@ -26,7 +26,7 @@ mod validate;
 pub mod wide;
 
 pub use node::{ChildRef, MAX_DEPTH, Node};
-pub use wide::{Bvh8, Bvh8Params, NodeSimd};
+pub use wide::{Bvh4, Bvh8, Bvh8Params, BvhWide, NodeSimd, WideParams};
 
 use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount};
 use raybench_geom::{MollerTriangle, Ray, TriangleMesh};

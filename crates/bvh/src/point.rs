@@ -19,7 +19,7 @@ use crate::Bvh;
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::simd::F4;
 use crate::tri4::Tri4;
-use crate::wide::{Node8, WIDTH};
+use crate::wide::{MAX_WIDTH, WideNode, quad};
 use raybench_accel::{CounterSink, Nearest, PointHit};
 use raybench_geom::{Aabb, TriangleMesh, Vec3, box_distance_squared};
 
@@ -117,30 +117,30 @@ fn binary_leaf<C: CounterSink>(bvh: &Bvh, r: ChildRef, p: Vec3, nearest: &mut Ne
     }
 }
 
-// ---- 8-wide BVH -------------------------------------------------------------------------
+// ---- wide BVHs (4 and 8 children) -------------------------------------------------------
 
-/// What the wide walk reads of a [`crate::Bvh8`] (its fields are private to `wide`).
-pub(crate) struct WideView<'a> {
+/// What the wide walk reads of a [`crate::wide::BvhWide`] (its fields are private to `wide`).
+pub(crate) struct WideView<'a, const W: usize> {
     pub root: ChildRef,
     pub root_bounds: &'a Aabb,
-    pub nodes: &'a [Node8],
+    pub nodes: &'a [WideNode<W>],
     pub packets: &'a [Tri4],
     pub mesh: &'a TriangleMesh,
 }
 
-/// Stack entries the wide walk can need: a node pushes at most `WIDTH - 1`, one node per
+/// Stack entries the wide walk can need: a node pushes at most `MAX_WIDTH - 1`, one node per
 /// level, and the depth is at most [`MAX_DEPTH`].
-const WIDE_STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
+const WIDE_STACK: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
 
-/// Squared distances from the point to all eight children of a wide node (unused slots hold
-/// empty boxes: infinitely far).
+/// Squared distances from the point to all children of a wide node, four at a time (unused
+/// slots hold empty boxes: infinitely far).
 #[inline(always)]
-fn wide_child_distances(p: &SplatPoint, n: &Node8) -> [f32; WIDTH] {
-    let mut d = [0.0; WIDTH];
-    for half in 0..2 {
-        let lo = n.planes.map(|a| F4::load(&a[0][half]));
-        let hi = n.planes.map(|a| F4::load(&a[1][half]));
-        d[4 * half..4 * half + 4].copy_from_slice(&p.box_distances(lo, hi).to_array());
+fn wide_child_distances<const W: usize>(p: &SplatPoint, n: &WideNode<W>) -> [f32; W] {
+    let mut d = [0.0; W];
+    for q in 0..W / 4 {
+        let lo = n.planes.map(|a| F4::load(quad(&a[0], q)));
+        let hi = n.planes.map(|a| F4::load(quad(&a[1], q)));
+        d[4 * q..4 * q + 4].copy_from_slice(&p.box_distances(lo, hi).to_array());
     }
     d
 }
@@ -148,11 +148,11 @@ fn wide_child_distances(p: &SplatPoint, n: &Node8) -> [f32; WIDTH] {
 /// The children of a wide node within `bound`, sorted nearest first (insertion sort on at most
 /// eight entries, in registers). Returns how many there are.
 #[inline(always)]
-fn children_within(
-    n: &Node8,
-    d: &[f32; WIDTH],
+fn children_within<const W: usize>(
+    n: &WideNode<W>,
+    d: &[f32; W],
     bound: f32,
-    out: &mut [(ChildRef, f32); WIDTH],
+    out: &mut [(ChildRef, f32); W],
 ) -> usize {
     let mut len = 0;
     for (i, &di) in d.iter().enumerate() {
@@ -170,9 +170,9 @@ fn children_within(
     len
 }
 
-/// The closest-point walk of the 8-wide BVH, counting into `c` (a no-op for `NoCount`).
-pub(crate) fn closest_point_wide<C: CounterSink>(
-    bvh: &WideView<'_>,
+/// The closest-point walk of a wide BVH, counting into `c` (a no-op for `NoCount`).
+pub(crate) fn closest_point_wide<const W: usize, C: CounterSink>(
+    bvh: &WideView<'_, W>,
     p: Vec3,
     max_radius: f32,
     c: &mut C,
@@ -185,7 +185,7 @@ pub(crate) fn closest_point_wide<C: CounterSink>(
     let mut stack = [(ChildRef::default(), 0f32); WIDE_STACK];
     let mut sp = 0;
     let mut next = Some(bvh.root);
-    let mut kids = [(ChildRef::default(), 0f32); WIDTH];
+    let mut kids = [(ChildRef::default(), 0f32); W];
     'walk: loop {
         while let Some(r) = next.take() {
             if r.is_leaf() {
@@ -221,8 +221,8 @@ pub(crate) fn closest_point_wide<C: CounterSink>(
 
 /// The `count` used lanes of the leaf's packets, one exact distance each.
 #[inline(always)]
-fn wide_leaf<C: CounterSink>(
-    bvh: &WideView<'_>,
+fn wide_leaf<const W: usize, C: CounterSink>(
+    bvh: &WideView<'_, W>,
     r: ChildRef,
     p: Vec3,
     nearest: &mut Nearest,
@@ -260,15 +260,15 @@ mod tests {
 
     #[test]
     fn children_are_sorted_and_pruned() {
-        let mut n = Node8 {
-            planes: [[[[0.0; 4]; 2]; 2]; 3],
-            child: [ChildRef::default(); WIDTH],
+        let mut n = WideNode::<8> {
+            planes: [[[0.0; 8]; 2]; 3],
+            child: [ChildRef::default(); 8],
         };
         for (i, c) in n.child.iter_mut().enumerate() {
             c.index = i as u32;
         }
         let d = [5.0, 1.0, f32::INFINITY, 3.0, 0.0, 9.0, 3.0, 2.0];
-        let mut out = [(ChildRef::default(), 0f32); WIDTH];
+        let mut out = [(ChildRef::default(), 0f32); 8];
         let len = children_within(&n, &d, 5.0, &mut out);
         let order: Vec<u32> = out[..len].iter().map(|(c, _)| c.index).collect();
         assert_eq!(

@@ -1,26 +1,29 @@
-//! An 8-wide BVH collapsed from the binary SAH tree, traversed with one SIMD box test per node
-//! (the first step of issue 8; see the README for where it stands against Embree).
+//! Wide BVHs — 8 children per node ([`Bvh8`]) or 4 ([`Bvh4`]) — collapsed from the binary SAH
+//! tree, traversed with one SIMD box test per node (issue 8; see the README for where they
+//! stand against Embree).
 //!
-//! Collapse (as in Wald et al. 2008, "Getting rid of packets", and Embree's BVH8 builders):
-//! each wide node starts from a binary node's two children and repeatedly opens the child with
-//! the largest surface area — the one a ray is most likely to enter — until it has 8 children
-//! or only leaves remain. Leaves are the binary tree's leaves, unchanged. The wide tree has a
-//! third of the binary tree's depth, so a ray walks fewer, wider nodes: fewer dependent memory
-//! fetches, each testing up to 8 boxes in two 4-lane SSE passes per axis.
+//! Collapse (as in Wald et al. 2008, "Getting rid of packets", and Embree's BVH4/BVH8
+//! builders): each wide node starts from a binary node's two children and repeatedly opens the
+//! child with the largest surface area — the one a ray is most likely to enter — until it has
+//! `W` children or only leaves remain. Leaves are the binary tree's leaves, unchanged. The
+//! wide tree has about a third (8 wide) or half (4 wide) of the binary tree's depth, so a ray
+//! walks fewer, wider nodes: fewer dependent memory fetches. The trade-off between the widths:
+//! a 4-wide node is two cache lines and one 4-lane SSE test per axis, an 8-wide node four
+//! lines and one 8-lane AVX2 test, and fewer of them on a ray's path.
 //!
 //! Traversal is ordered: the children a ray enters are sorted by entry distance, the farther
 //! ones pushed with that distance and skipped when popped beyond the closest hit.
 //!
 //! Leaves are SIMD packets ([`Tri4`]): the binary builder prices a leaf by the packets of four
 //! it fills (`leaf_block = 4`), and one SSE Möller–Trumbore test answers for four triangles.
-//! The node test runs in one 8-lane AVX2 pass per axis when the CPU has AVX2 (detected at build
-//! time, [`crate::avx2`]) and in two 4-lane SSE passes otherwise; both are the scalar slab test
-//! lane for lane and pass the same conformance tests.
+//! An 8-wide node is tested in one 8-lane AVX2 pass per axis when the CPU has AVX2 (detected
+//! at build time, [`crate::avx2`]) and in two 4-lane SSE passes otherwise; both are the scalar
+//! slab test lane for lane and pass the same conformance tests.
 
 use crate::BvhParams;
 use crate::build;
 use crate::node::{ChildRef, MAX_DEPTH, Node};
-use crate::simd::F4;
+use crate::simd::{F4, prefetch};
 use crate::tri4::{NO_PRIM, Ray4, Tri4};
 use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, NoCount, PreparedRays,
@@ -31,40 +34,41 @@ use serde::Serialize;
 use std::cell::RefCell;
 use std::sync::Arc;
 
-/// Children per wide node.
-pub const WIDTH: usize = 8;
+/// The widest node built (and the size of every traversal stack).
+pub const MAX_WIDTH: usize = 8;
 
-/// Stack entries a walk can need: a node pushes at most `WIDTH - 1`, one per level, and the
-/// binary builder caps the depth at [`MAX_DEPTH`] (collapsing only shortens it).
-const STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
+/// Stack entries a walk can need: a node pushes at most `MAX_WIDTH - 1`, one per level, and
+/// the binary builder caps the depth at [`MAX_DEPTH`] (collapsing only shortens it).
+const STACK: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
 
-/// One wide node: 256 bytes, four cache lines. Child boxes per axis as `[min or max][half]`
-/// of 4 lanes; unused slots hold an empty box (`min = +inf`, `max = -inf`) that no ray enters.
+/// One wide node of `W` children (4 or 8): child boxes per axis as `[min or max][slot]`, so
+/// one SIMD load fetches a plane of four or eight children; unused slots hold an empty box
+/// (`min = +inf`, `max = -inf`) that no ray enters. 8 wide: 256 bytes, four cache lines;
+/// 4 wide: 128 bytes, two.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-pub struct Node8 {
-    /// `[axis][0 = min, 1 = max][half][lane]`, child `4 * half + lane`.
-    pub planes: [[[[f32; 4]; 2]; 2]; 3],
-    pub child: [ChildRef; WIDTH],
+pub struct WideNode<const W: usize> {
+    /// `[axis][0 = min, 1 = max][slot]`.
+    pub planes: [[[f32; W]; 2]; 3],
+    pub child: [ChildRef; W],
 }
 
-const _: () = assert!(std::mem::size_of::<Node8>() == 256);
+pub type Node8 = WideNode<8>;
+pub type Node4 = WideNode<4>;
 
-impl Node8 {
-    fn empty() -> Node8 {
-        let mut planes = [[[[0.0; 4]; 2]; 2]; 3];
-        for axis in &mut planes {
-            axis[0] = [[f32::INFINITY; 4]; 2];
-            axis[1] = [[f32::NEG_INFINITY; 4]; 2];
-        }
-        Node8 {
-            planes,
-            child: [ChildRef::default(); WIDTH],
+const _: () = assert!(std::mem::size_of::<Node8>() == 256);
+const _: () = assert!(std::mem::size_of::<Node4>() == 128);
+
+impl<const W: usize> WideNode<W> {
+    fn empty() -> WideNode<W> {
+        WideNode {
+            planes: [[[f32::INFINITY; W], [f32::NEG_INFINITY; W]]; 3],
+            child: [ChildRef::default(); W],
         }
     }
 
     pub fn child_bounds(&self, i: usize) -> Aabb {
-        let at = |axis: usize, side: usize| self.planes[axis][side][i / 4][i % 4];
+        let at = |axis: usize, side: usize| self.planes[axis][side][i];
         Aabb::new(
             Vec3::new(at(0, 0), at(1, 0), at(2, 0)),
             Vec3::new(at(0, 1), at(1, 1), at(2, 1)),
@@ -73,18 +77,24 @@ impl Node8 {
 
     fn set_child(&mut self, i: usize, b: &Aabb, r: ChildRef) {
         for axis in 0..3 {
-            self.planes[axis][0][i / 4][i % 4] = b.min[axis];
-            self.planes[axis][1][i / 4][i % 4] = b.max[axis];
+            self.planes[axis][0][i] = b.min[axis];
+            self.planes[axis][1][i] = b.max[axis];
         }
         self.child[i] = r;
     }
 
     /// Slots in use: children are packed from slot 0.
     pub fn children(&self) -> usize {
-        (0..WIDTH)
-            .take_while(|&i| self.planes[0][0][i / 4][i % 4] <= self.planes[0][1][i / 4][i % 4])
+        (0..W)
+            .take_while(|&i| self.planes[0][0][i] <= self.planes[0][1][i])
             .count()
     }
+}
+
+/// The four lanes `4 * q ..` of a plane row, for one SSE load.
+#[inline(always)]
+pub(crate) fn quad<const W: usize>(row: &[f32; W], q: usize) -> &[f32; 4] {
+    &row.as_chunks::<4>().0[q]
 }
 
 /// Which instructions test a wide node.
@@ -98,17 +108,33 @@ pub enum NodeSimd {
     Sse,
 }
 
-/// Knobs of the wide BVH: the binary tree it is collapsed from, and the node test.
+/// Knobs of a wide BVH: the binary tree it is collapsed from, the node width and the node
+/// test.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Bvh8Params {
+pub struct WideParams {
     pub binary: BvhParams,
+    /// Children per node: 8 ([`Bvh8`]) or 4 ([`Bvh4`]); a tree is built only with its own.
     pub width: u32,
+    /// For 8-wide nodes (4-wide ones always take one 4-lane SSE pass per axis).
     pub node_simd: NodeSimd,
 }
 
-impl Default for Bvh8Params {
+/// The 8-wide tree's knobs (the name the reports and tests have used since issue 8 began).
+pub type Bvh8Params = WideParams;
+
+impl WideParams {
+    /// The defaults for nodes of `width` children.
+    pub fn for_width(width: u32) -> WideParams {
+        WideParams {
+            width,
+            ..WideParams::default()
+        }
+    }
+}
+
+impl Default for WideParams {
     fn default() -> Self {
-        Bvh8Params {
+        WideParams {
             // A packet test costs about one wide node test, as Embree's BVH8 builder prices
             // them (intersection cost 1 per block of 4, traversal cost 1): 0.25 per triangle
             // slot. Leaves of up to 16 (four packets) let the SAH stop early where triangles
@@ -121,18 +147,18 @@ impl Default for Bvh8Params {
                 max_leaf_size: 16,
                 ..BvhParams::binned()
             },
-            width: WIDTH as u32,
+            width: MAX_WIDTH as u32,
             node_simd: NodeSimd::Auto,
         }
     }
 }
 
-/// A wide BVH. A leaf reference is `{ index: first packet, count: triangles }`; its triangles
-/// fill `count.div_ceil(4)` consecutive packets, lane by lane.
+/// A wide BVH of `W`-child nodes. A leaf reference is `{ index: first packet, count:
+/// triangles }`; its triangles fill `count.div_ceil(4)` consecutive packets, lane by lane.
 #[derive(Debug)]
-pub struct Bvh8 {
-    params: Bvh8Params,
-    nodes: Vec<Node8>,
+pub struct BvhWide<const W: usize> {
+    params: WideParams,
+    nodes: Vec<WideNode<W>>,
     root: ChildRef,
     root_bounds: Aabb,
     /// Leaf triangles, four to a packet, each lane with its mesh index ([`NO_PRIM`] unused).
@@ -142,6 +168,11 @@ pub struct Bvh8 {
     #[cfg(target_arch = "x86_64")]
     avx2: Option<crate::avx2::Avx2Nodes>,
 }
+
+/// 8 children per node, tested in one AVX2 pass per axis: the structure that races Embree.
+pub type Bvh8 = BvhWide<8>;
+/// 4 children per node, tested in one SSE pass per axis: half the node bytes, twice the depth.
+pub type Bvh4 = BvhWide<4>;
 
 /// Appends the packets of one binary leaf (mesh triangles `ids`) and returns its wide reference.
 fn pack_leaf(mesh: &TriangleMesh, ids: &[u32], packets: &mut Vec<Tri4>) -> ChildRef {
@@ -161,10 +192,10 @@ fn pack_leaf(mesh: &TriangleMesh, ids: &[u32], packets: &mut Vec<Tri4>) -> Child
 
 /// Collapses the binary subtree `r` into wide nodes appended to `out` depth-first; `leaf`
 /// turns each binary leaf into its wide reference, in depth-first order.
-fn collapse(
+fn collapse<const W: usize>(
     binary: &[Node],
     r: ChildRef,
-    out: &mut Vec<Node8>,
+    out: &mut Vec<WideNode<W>>,
     leaf: &mut impl FnMut(ChildRef) -> ChildRef,
 ) -> ChildRef {
     if r.is_leaf() {
@@ -175,7 +206,7 @@ fn collapse(
         (n.child[0], n.child_bounds(0)),
         (n.child[1], n.child_bounds(1)),
     ];
-    while kids.len() < WIDTH {
+    while kids.len() < W {
         // Open the interior child with the largest area (first such on ties: deterministic).
         let Some(i) = (0..kids.len())
             .filter(|&i| !kids[i].0.is_leaf())
@@ -194,7 +225,7 @@ fn collapse(
         kids.insert(i + 1, (m.child[1], m.child_bounds(1)));
     }
     let at = out.len();
-    out.push(Node8::empty());
+    out.push(WideNode::empty());
     for (slot, (child, bounds)) in kids.iter().enumerate() {
         let r = collapse(binary, *child, out, leaf);
         out[at].set_child(slot, bounds, r);
@@ -205,13 +236,13 @@ fn collapse(
     }
 }
 
-impl Bvh8 {
-    pub fn nodes(&self) -> &[Node8] {
+impl<const W: usize> BvhWide<W> {
+    pub fn nodes(&self) -> &[WideNode<W>] {
         &self.nodes
     }
 
     /// The parts the closest-point walk reads (`point.rs`).
-    pub(crate) fn point_view(&self) -> crate::point::WideView<'_> {
+    pub(crate) fn point_view(&self) -> crate::point::WideView<'_, W> {
         crate::point::WideView {
             root: self.root,
             root_bounds: &self.root_bounds,
@@ -221,7 +252,7 @@ impl Bvh8 {
         }
     }
 
-    pub fn params(&self) -> &Bvh8Params {
+    pub fn params(&self) -> &WideParams {
         &self.params
     }
 
@@ -322,7 +353,7 @@ impl Bvh8 {
         if used < 2 {
             return Err(format!("node {} has {used} children", r.index));
         }
-        for i in 0..WIDTH {
+        for i in 0..W {
             let child = node.child_bounds(i);
             if i >= used {
                 if !child.is_empty() {
@@ -342,7 +373,7 @@ impl Bvh8 {
     }
 }
 
-impl Bvh8 {
+impl<const W: usize> BvhWide<W> {
     /// A leaf: at the next packet in depth-first order, `count` used lanes followed by unused
     /// ones, every triangle inside the leaf's box.
     fn walk_leaf(
@@ -378,13 +409,14 @@ impl Bvh8 {
 /// within `[t_min, t_max]`. Implementations compute the scalar slab test's arithmetic lane for
 /// lane, so every kernel answers alike; a NaN (`0 * inf`, a ray in a box's face plane) is
 /// ignored because the `max`/`min` keep the accumulator (bug class B1).
-pub(crate) trait NodeKernel: Copy {
+pub(crate) trait NodeKernel<const W: usize>: Copy {
     type Ray;
     fn ray(self, ray: &Ray) -> Self::Ray;
-    fn test(self, ray: &Self::Ray, n: &Node8, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]);
+    fn test(self, ray: &Self::Ray, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]);
 }
 
-/// The baseline kernel: two 4-lane passes per axis (SSE on x86-64, portable elsewhere).
+/// The baseline kernel: one 4-lane pass per axis and four children (SSE on x86-64, portable
+/// elsewhere).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SseNodes;
 
@@ -396,7 +428,7 @@ pub(crate) struct WideRay {
     near: [bool; 3],
 }
 
-impl NodeKernel for SseNodes {
+impl<const W: usize> NodeKernel<W> for SseNodes {
     type Ray = WideRay;
 
     #[inline(always)]
@@ -411,20 +443,20 @@ impl NodeKernel for SseNodes {
     }
 
     #[inline(always)]
-    fn test(self, r: &WideRay, n: &Node8, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+    fn test(self, r: &WideRay, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]) {
         let mut mask = 0;
-        let mut entry = [0.0; WIDTH];
-        for half in 0..2 {
+        let mut entry = [0.0; W];
+        for q in 0..W / 4 {
             let mut t0 = F4::splat(t_min);
             let mut t1 = F4::splat(t_max);
             for a in 0..3 {
-                let near = F4::load(&n.planes[a][r.near[a] as usize][half]);
-                let far = F4::load(&n.planes[a][!r.near[a] as usize][half]);
+                let near = F4::load(quad(&n.planes[a][r.near[a] as usize], q));
+                let far = F4::load(quad(&n.planes[a][!r.near[a] as usize], q));
                 t0 = near.sub(r.origin[a]).mul(r.inv[a]).max_keep(t0);
                 t1 = far.sub(r.origin[a]).mul(r.inv[a]).min_keep(t1);
             }
-            mask |= t0.le_mask(t1) << (4 * half);
-            entry[4 * half..4 * half + 4].copy_from_slice(&t0.to_array());
+            mask |= t0.le_mask(t1) << (4 * q);
+            entry[4 * q..4 * q + 4].copy_from_slice(&t0.to_array());
         }
         (mask, entry)
     }
@@ -447,10 +479,10 @@ thread_local! {
 /// Any hit will do, so no sorting (as Embree's occlusion traversal): returns the child in the
 /// lowest slot of `mask` and pushes the others to pop in slot order.
 #[inline(always)]
-fn first_in_slot_order(
-    n: &Node8,
+fn first_in_slot_order<const W: usize>(
+    n: &WideNode<W>,
     mask: u32,
-    entry: &[f32; WIDTH],
+    entry: &[f32; W],
     stack: &mut Stack,
     sp: &mut usize,
 ) -> ChildRef {
@@ -469,10 +501,10 @@ fn first_in_slot_order(
 /// the others so that they pop nearest first (equal distances: lower slot first). One and two
 /// children — most nodes — take a short path; more are inserted into the stack in place.
 #[inline(always)]
-fn nearest_first(
-    n: &Node8,
+fn nearest_first<const W: usize>(
+    n: &WideNode<W>,
     mut mask: u32,
-    entry: &[f32; WIDTH],
+    entry: &[f32; W],
     stack: &mut Stack,
     sp: &mut usize,
 ) -> ChildRef {
@@ -539,12 +571,12 @@ fn intersect_packets<const ANY_HIT: bool, C: CounterSink>(
     false
 }
 
-impl Bvh8 {
+impl<const W: usize> BvhWide<W> {
     /// The one traversal loop — closest or any hit, counted or not — for a given node
     /// kernel. `stack` is scratch space, so batch callers reuse one allocation for all their
     /// rays. There is no separate test of the root box: the root node's test covers it.
     #[inline(always)]
-    pub(crate) fn walk_ray<const ANY_HIT: bool, C: CounterSink, K: NodeKernel>(
+    pub(crate) fn walk_ray<const ANY_HIT: bool, C: CounterSink, K: NodeKernel<W>>(
         &self,
         kernel: K,
         ray: &Ray,
@@ -578,6 +610,7 @@ impl Bvh8 {
                 let n = &self.nodes[r.index as usize];
                 let (mask, entry) = kernel.test(&wide, n, t_min, best_t);
                 if mask != 0 {
+                    self.prefetch_children(n, mask);
                     r = if ANY_HIT {
                         first_in_slot_order(n, mask, &entry, stack, &mut sp)
                     } else {
@@ -607,7 +640,23 @@ impl Bvh8 {
         })
     }
 
-    /// [`Bvh8::walk_ray`] with the kernel chosen at build time.
+    /// Starts fetching every child in `mask`: a node's four (8 wide) or two (4 wide) lines, or
+    /// a leaf's first packet (three lines).
+    #[inline(always)]
+    fn prefetch_children(&self, n: &WideNode<W>, mut mask: u32) {
+        while mask != 0 {
+            let r = n.child[mask.trailing_zeros() as usize];
+            mask &= mask - 1;
+            if r.is_leaf() {
+                prefetch(self.packets.as_ptr().wrapping_add(r.index as usize));
+            } else {
+                prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
+            }
+        }
+    }
+
+    /// [`BvhWide::walk_ray`] with the kernel chosen at build time.
+    #[inline(always)]
     fn trace<const ANY_HIT: bool, C: CounterSink>(
         &self,
         ray: &Ray,
@@ -616,7 +665,7 @@ impl Bvh8 {
     ) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
         if let Some(k) = self.avx2 {
-            return crate::avx2::walk_ray::<ANY_HIT, C>(self, k, ray, stack, c);
+            return crate::avx2::walk_ray::<W, ANY_HIT, C>(self, k, ray, stack, c);
         }
         self.walk_ray::<ANY_HIT, C, SseNodes>(SseNodes, ray, stack, c)
     }
@@ -630,13 +679,13 @@ impl Bvh8 {
     }
 }
 
-impl Accel for Bvh8 {
-    type Params = Bvh8Params;
+impl<const W: usize> Accel for BvhWide<W> {
+    type Params = WideParams;
 
-    fn build(mesh: Arc<TriangleMesh>, params: &Bvh8Params) -> Result<Bvh8, BuildError> {
-        if params.width as usize != WIDTH {
+    fn build(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<BvhWide<W>, BuildError> {
+        if params.width as usize != W {
             return Err(BuildError::Unsupported(format!(
-                "width {} (only {WIDTH})",
+                "width {} in a {W}-wide BVH",
                 params.width
             )));
         }
@@ -651,7 +700,7 @@ impl Accel for Bvh8 {
                 pack_leaf(&mesh, ids, &mut packets)
             })
         };
-        Ok(Bvh8 {
+        Ok(BvhWide {
             params: params.clone(),
             nodes,
             root,
@@ -659,15 +708,19 @@ impl Accel for Bvh8 {
             packets,
             mesh,
             #[cfg(target_arch = "x86_64")]
+            // AVX2 tests eight children a pass; four fit one SSE pass.
             avx2: match params.node_simd {
-                NodeSimd::Auto => crate::avx2::Avx2Nodes::detect(),
-                NodeSimd::Sse => None,
+                NodeSimd::Auto if W.is_multiple_of(8) => crate::avx2::Avx2Nodes::detect(),
+                _ => None,
             },
         })
     }
 
     fn name(&self) -> &str {
-        "bvh8-binned"
+        match W {
+            4 => "bvh4-binned",
+            _ => "bvh8-binned",
+        }
     }
 
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
@@ -735,7 +788,7 @@ impl Accel for Bvh8 {
     }
 }
 
-impl Bvh8 {
+impl<const W: usize> BvhWide<W> {
     /// Shape and SAH cost of the wide tree (a wide node costs one traversal step: one SIMD
     /// node test), with the constants shared by every structure.
     fn measure(&self) -> BuildStats {

@@ -1,6 +1,6 @@
 //! The shared conformance suite for every BVH variant, `validate()` after every build.
 
-use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, WideParams};
 use raybench_testkit::conformance;
 
 fn check(params: BvhParams) {
@@ -55,21 +55,66 @@ fn binned_conforms_on_the_shared_scenes() {
     eprintln!("real scenes checked: {checked}");
 }
 
-#[test]
-fn wide_conforms() {
-    let counts = conformance::<Bvh8>(&Bvh8Params::default(), &|b, mesh| b.validate(mesh));
-    assert_eq!(counts.mismatch, 0);
-    assert!(counts.exact > 10_000, "{counts:?}");
-    // Tiny leaves make deep binary trees and full wide nodes.
-    let tiny = Bvh8Params {
+/// The defaults and, with tiny leaves, deep binary trees collapsed into full wide nodes.
+fn wide_params(width: u32) -> [WideParams; 2] {
+    let tiny = WideParams {
         binary: BvhParams {
             max_leaf_size: 1,
             ..BvhParams::binned()
         },
-        ..Bvh8Params::default()
+        ..WideParams::for_width(width)
     };
-    let counts = conformance::<Bvh8>(&tiny, &|b, mesh| b.validate(mesh));
-    assert_eq!(counts.mismatch, 0);
+    [WideParams::for_width(width), tiny]
+}
+
+#[test]
+fn wide_conforms() {
+    for params in wide_params(8) {
+        let counts = conformance::<Bvh8>(&params, &|b, mesh| b.validate(mesh));
+        assert_eq!(counts.mismatch, 0, "{params:?}");
+        assert!(counts.exact > 10_000, "{counts:?}");
+    }
+}
+
+#[test]
+fn four_wide_conforms() {
+    for params in wide_params(4) {
+        let counts = conformance::<Bvh4>(&params, &|b, mesh| b.validate(mesh));
+        assert_eq!(counts.mismatch, 0, "{params:?}");
+        assert!(counts.exact > 10_000, "{counts:?}");
+    }
+}
+
+/// A tree is built only with its own width: the knob in the report is the tree's shape.
+#[test]
+fn a_width_other_than_the_trees_is_refused() {
+    use raybench_accel::{Accel, BuildError};
+    let mesh = raybench_scenes::generate("soup:triangles=100", 1)
+        .expect("generates")
+        .mesh;
+    for r in [
+        Bvh4::build(mesh.clone(), &WideParams::for_width(8)).map(|_| ()),
+        Bvh8::build(mesh.clone(), &WideParams::for_width(4)).map(|_| ()),
+    ] {
+        assert!(matches!(r, Err(BuildError::Unsupported(_))), "{r:?}");
+    }
+}
+
+/// Collapsing the same binary tree to 4 and to 8 children keeps every triangle in the same
+/// leaves: both report the same leaves and references, and the 8-wide tree is shallower.
+#[test]
+fn both_widths_share_the_leaves_and_differ_in_depth() {
+    use raybench_accel::Accel;
+    let mesh = raybench_scenes::generate("teapot:triangles=20000", 1)
+        .expect("generates")
+        .mesh;
+    let four = Bvh4::build(mesh.clone(), &WideParams::for_width(4)).expect("builds");
+    let eight = Bvh8::build(mesh.clone(), &WideParams::for_width(8)).expect("builds");
+    let (s4, s8) = (four.build_stats(), eight.build_stats());
+    assert_eq!((s4.leaves, s4.refs), (s8.leaves, s8.refs));
+    assert!(s8.max_depth < s4.max_depth, "{s4:?} {s8:?}");
+    assert!(four.nodes().len() > eight.nodes().len());
+    assert!(s4.extra["mean_children"] <= 4.0 && s8.extra["mean_children"] > 4.0);
 }
 
 /// The SSE node kernel (what a CPU without AVX2 runs) answers like the AVX2 one: the same
@@ -106,7 +151,11 @@ fn wide_conforms_on_the_shared_scenes() {
         raybench_testkit::conformance_on_shared_scenes::<Bvh8>(&Bvh8Params::default(), &|b, m| {
             b.validate(m)
         });
-    eprintln!("real scenes checked: {checked}");
+    let four = raybench_testkit::conformance_on_shared_scenes::<Bvh4>(
+        &WideParams::for_width(4),
+        &|b, m| b.validate(m),
+    );
+    eprintln!("real scenes checked: {checked} (8 wide), {four} (4 wide)");
 }
 
 // ---- Closest-point queries --------------------------------------------------------------
@@ -143,6 +192,10 @@ fn wide_point_queries_conform() {
     };
     for params in [Bvh8Params::default(), tiny] {
         let counts = point_conformance::<Bvh8>(&params, &|b, m| b.validate(m));
+        assert_eq!(counts.mismatch, 0, "{params:?}");
+    }
+    for params in wide_params(4) {
+        let counts = point_conformance::<Bvh4>(&params, &|b, m| b.validate(m));
         assert_eq!(counts.mismatch, 0, "{params:?}");
     }
 }
@@ -190,6 +243,11 @@ fn too_large_is_an_error_not_an_abort() {
         ..Bvh8Params::default()
     };
     refused(Bvh8::build(mesh.clone(), &wide).map(|_| ()));
+    let four = WideParams {
+        width: 4,
+        ..wide.clone()
+    };
+    refused(Bvh4::build(mesh.clone(), &four).map(|_| ()));
     // The default limit builds it.
     assert!(Bvh::build(mesh, &BvhParams::binned()).is_ok());
 }

@@ -2,7 +2,7 @@
 //! (see README, "Adding a structure").
 
 use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
-use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
 use raybench_grid::{Grid, GridParams};
@@ -139,11 +139,17 @@ pub fn registry() -> Vec<StructureEntry> {
             None,
             |_| BvhParams::binned_unordered(),
         ),
+        register::<Bvh4>(
+            "bvh4-binned",
+            "4-wide BVH collapsed from a binned SAH tree priced for SIMD 4-triangle leaves, SSE box test of 4 children, ordered",
+            None,
+            |_| WideParams::for_width(4),
+        ),
         register::<Bvh8>(
             "bvh8-binned",
-            "8-wide BVH collapsed from the bvh-binned tree, SSE box test of 8 children, ordered",
+            "8-wide BVH collapsed from a binned SAH tree priced for SIMD 4-triangle leaves, AVX2 box test of 8 children (SSE fallback), ordered",
             None,
-            |_| Bvh8Params::default(),
+            |_| WideParams::for_width(8),
         ),
         register::<KdTree>(
             "kd-sah",

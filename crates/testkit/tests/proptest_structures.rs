@@ -21,7 +21,7 @@
 use proptest::prelude::*;
 use proptest::test_runner::FileFailurePersistence;
 use raybench_accel::compare::VerdictCounts;
-use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, WideParams};
 use raybench_geom::{Aabb, Ray, Triangle, TriangleMesh, Vec3};
 use raybench_grid::{Grid, GridParams};
 use raybench_kdtree::{KdParams, KdTree};
@@ -286,6 +286,9 @@ const STRUCTURES: [(&str, Check); 11] = [
     }),
     ("bvh-binned-unordered", |c| {
         check_case::<Bvh>(c, &BvhParams::binned_unordered(), &|a, m| a.validate(m))
+    }),
+    ("bvh4-binned", |c| {
+        check_case::<Bvh4>(c, &WideParams::for_width(4), &|a, m| a.validate(m))
     }),
     ("bvh8-binned", |c| {
         check_case::<Bvh8>(c, &Bvh8Params::default(), &|a, m| a.validate(m))
