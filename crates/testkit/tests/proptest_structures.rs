@@ -274,7 +274,7 @@ type Check = fn(&Case) -> Result<VerdictCounts, String>;
 
 /// Every structure with the parameters the registry builds it with
 /// (crates/harness/src/registry.rs), `validate()` after the build.
-const STRUCTURES: [(&str, Check); 11] = [
+const STRUCTURES: [(&str, Check); 12] = [
     ("bvh-median", |c| {
         check_case::<Bvh>(c, &BvhParams::median(), &|a, m| a.validate(m))
     }),
