@@ -175,19 +175,27 @@ pub type Bvh8 = BvhWide<8>;
 pub type Bvh4 = BvhWide<4>;
 
 /// Appends the packets of one binary leaf (mesh triangles `ids`) and returns its wide reference.
-fn pack_leaf(mesh: &TriangleMesh, ids: &[u32], packets: &mut Vec<Tri4>) -> ChildRef {
-    let index = packets.len() as u32;
-    for chunk in ids.chunks(4) {
+fn pack_leaf(mesh: &TriangleMesh, ids: &[u32]) -> impl Iterator<Item = Tri4> {
+    ids.chunks(4).map(|chunk| {
         let mut packet = Tri4::default();
         for (lane, &i) in chunk.iter().enumerate() {
             packet.set_lane(lane, i, &MollerTriangle::new(&mesh.triangle(i as usize)));
         }
-        packets.push(packet);
-    }
-    ChildRef {
-        index,
-        count: ids.len() as u32,
-    }
+        packet
+    })
+}
+
+/// The packets of every binary leaf in `leaves` (depth-first order), built on rayon: gathering
+/// each triangle's vertices from the mesh is the part of the collapse that touches memory at
+/// random, and leaves are independent. `collect` keeps their order, so the result does not
+/// depend on the thread count.
+fn pack_leaves(mesh: &TriangleMesh, prim_ids: &[u32], leaves: &[ChildRef]) -> Vec<Tri4> {
+    use rayon::prelude::*;
+    leaves
+        .par_iter()
+        .with_min_len(256)
+        .flat_map_iter(|r| pack_leaf(mesh, &prim_ids[r.index as usize..(r.index + r.count) as usize]))
+        .collect()
 }
 
 /// Collapses the binary subtree `r` into wide nodes appended to `out` depth-first; `leaf`
@@ -202,13 +210,14 @@ fn collapse<const W: usize>(
         return leaf(r);
     }
     let n = &binary[r.index as usize];
-    let mut kids: Vec<(ChildRef, Aabb)> = vec![
-        (n.child[0], n.child_bounds(0)),
-        (n.child[1], n.child_bounds(1)),
-    ];
-    while kids.len() < W {
+    // A fixed array, not a Vec: one wide node per call, no allocation.
+    let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
+    kids[0] = (n.child[0], n.child_bounds(0));
+    kids[1] = (n.child[1], n.child_bounds(1));
+    let mut len = 2;
+    while len < W {
         // Open the interior child with the largest area (first such on ties: deterministic).
-        let Some(i) = (0..kids.len())
+        let Some(i) = (0..len)
             .filter(|&i| !kids[i].0.is_leaf())
             .max_by(|&a, &b| {
                 kids[a]
@@ -221,12 +230,14 @@ fn collapse<const W: usize>(
             break;
         };
         let m = &binary[kids[i].0.index as usize];
+        kids.copy_within(i + 1..len, i + 2);
         kids[i] = (m.child[0], m.child_bounds(0));
-        kids.insert(i + 1, (m.child[1], m.child_bounds(1)));
+        kids[i + 1] = (m.child[1], m.child_bounds(1));
+        len += 1;
     }
     let at = out.len();
     out.push(WideNode::empty());
-    for (slot, (child, bounds)) in kids.iter().enumerate() {
+    for (slot, (child, bounds)) in kids[..len].iter().enumerate() {
         let r = collapse(binary, *child, out, leaf);
         out[at].set_child(slot, bounds, r);
     }
@@ -691,15 +702,24 @@ impl<const W: usize> Accel for BvhWide<W> {
         }
         let flat = build::build(&mesh, &params.binary)?;
         let mut nodes = Vec::with_capacity(flat.nodes.len() / 3 + 1);
-        let mut packets = Vec::with_capacity(flat.prim_ids.len() / 2 + 1);
+        // The collapse only numbers the leaves' packets; they are filled afterwards, in
+        // parallel.
+        let mut leaves = Vec::new();
+        let mut next_packet = 0u32;
         let root = if flat.prim_ids.is_empty() {
             ChildRef::default()
         } else {
             collapse(&flat.nodes, flat.root, &mut nodes, &mut |r| {
-                let ids = &flat.prim_ids[r.index as usize..(r.index + r.count) as usize];
-                pack_leaf(&mesh, ids, &mut packets)
+                leaves.push(r);
+                let index = next_packet;
+                next_packet += r.count.div_ceil(4);
+                ChildRef {
+                    index,
+                    count: r.count,
+                }
             })
         };
+        let packets = pack_leaves(&mesh, &flat.prim_ids, &leaves);
         Ok(BvhWide {
             params: params.clone(),
             nodes,
