@@ -194,7 +194,12 @@ fn pack_leaves(mesh: &TriangleMesh, prim_ids: &[u32], leaves: &[ChildRef]) -> Ve
     leaves
         .par_iter()
         .with_min_len(256)
-        .flat_map_iter(|r| pack_leaf(mesh, &prim_ids[r.index as usize..(r.index + r.count) as usize]))
+        .flat_map_iter(|r| {
+            pack_leaf(
+                mesh,
+                &prim_ids[r.index as usize..(r.index + r.count) as usize],
+            )
+        })
         .collect()
 }
 
@@ -217,16 +222,13 @@ fn collapse<const W: usize>(
     let mut len = 2;
     while len < W {
         // Open the interior child with the largest area (first such on ties: deterministic).
-        let Some(i) = (0..len)
-            .filter(|&i| !kids[i].0.is_leaf())
-            .max_by(|&a, &b| {
-                kids[a]
-                    .1
-                    .surface_area()
-                    .total_cmp(&kids[b].1.surface_area())
-                    .then(b.cmp(&a))
-            })
-        else {
+        let Some(i) = (0..len).filter(|&i| !kids[i].0.is_leaf()).max_by(|&a, &b| {
+            kids[a]
+                .1
+                .surface_area()
+                .total_cmp(&kids[b].1.surface_area())
+                .then(b.cmp(&a))
+        }) else {
             break;
         };
         let m = &binary[kids[i].0.index as usize];
