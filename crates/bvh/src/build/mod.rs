@@ -15,7 +15,7 @@
 //!
 //! Shape of the build: ranges above `parallel_threshold` are split on two rayon tasks
 //! ([`Part::Split`]); each range at or below it is built sequentially straight into its own
-//! depth-first node vector ([`Part::Local`]). Flattening then copies every node exactly once,
+//! depth-first node vector ([`Part::Local`]), all its nodes sharing one [`split::Scratch`]. Flattening then copies every node exactly once,
 //! relocating child indices — no node is boxed or allocated on its own.
 
 mod prim;
@@ -29,7 +29,7 @@ use prim::{MAX_PRIMS, PrimRef, Ranged};
 use raybench_accel::{BuildError, BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use raybench_geom::{Aabb, TriangleMesh};
 use rayon::prelude::*;
-use split::{PARALLEL_BINNING, Split, binned_split, median_split, sweep_split};
+use split::{PARALLEL_BINNING, Scratch, Split, binned_split, median_split, sweep_split};
 
 /// A built and flattened tree.
 pub(crate) struct Flat {
@@ -137,10 +137,10 @@ fn build_part(p: &BvhParams, refs: &mut [PrimRef], first: u32, r: Ranged, depth:
     let n = refs.len();
     if n <= p.parallel_threshold as usize {
         let mut nodes = Vec::new();
-        let root = build_local(p, refs, first, r, depth, &mut nodes);
+        let root = build_local(p, refs, first, r, depth, &mut nodes, &mut Scratch::new());
         return Part::Local { nodes, root };
     }
-    let Some(s) = decide(p, refs, &r, depth) else {
+    let Some(s) = decide(p, refs, &r, depth, &mut Scratch::new()) else {
         let root = ChildRef {
             index: first,
             count: n as u32,
@@ -170,8 +170,9 @@ fn build_local(
     r: Ranged,
     depth: usize,
     out: &mut Vec<Node>,
+    scratch: &mut Scratch,
 ) -> ChildRef {
-    let Some(s) = decide(p, refs, &r, depth) else {
+    let Some(s) = decide(p, refs, &r, depth, scratch) else {
         return ChildRef {
             index: first,
             count: refs.len() as u32,
@@ -183,14 +184,28 @@ fn build_local(
         [ChildRef::default(); 2],
     ));
     let (left, right) = refs.split_at_mut(s.mid);
-    let a = build_local(p, left, first, s.left, depth + 1, out);
-    let b = build_local(p, right, first + s.mid as u32, s.right, depth + 1, out);
+    let a = build_local(p, left, first, s.left, depth + 1, out, scratch);
+    let b = build_local(
+        p,
+        right,
+        first + s.mid as u32,
+        s.right,
+        depth + 1,
+        out,
+        scratch,
+    );
     out[at].child = [a, b];
     interior(at)
 }
 
 /// Whether and where a range splits: `None` makes it a leaf.
-fn decide(p: &BvhParams, refs: &mut [PrimRef], r: &Ranged, depth: usize) -> Option<Split> {
+fn decide(
+    p: &BvhParams,
+    refs: &mut [PrimRef],
+    r: &Ranged,
+    depth: usize,
+    scratch: &mut Scratch,
+) -> Option<Split> {
     let n = refs.len();
     if n == 1 || depth + 1 >= MAX_DEPTH {
         return None;
@@ -198,7 +213,7 @@ fn decide(p: &BvhParams, refs: &mut [PrimRef], r: &Ranged, depth: usize) -> Opti
     let split = match p.builder {
         Builder::Median => median_split(refs, r, p),
         Builder::Sweep => sweep_split(refs, r, p),
-        Builder::Binned => binned_split(refs, r, p),
+        Builder::Binned => binned_split(refs, r, p, scratch),
     };
     match split {
         Some(s) => {

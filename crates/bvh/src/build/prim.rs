@@ -44,6 +44,12 @@ impl PrimRef {
     pub(crate) fn centroid2(&self) -> Vec3A {
         Vec3A::from_vec4(self.lo) + Vec3A::from_vec4(self.hi)
     }
+
+    /// Lane `axis` of [`PrimRef::centroid2`], in scalar (the same sum).
+    #[inline(always)]
+    pub(crate) fn centroid2_on(&self, axis: usize) -> f32 {
+        self.lo[axis] + self.hi[axis]
+    }
 }
 
 const ID_TAG: u32 = 1 << 30;
@@ -95,6 +101,20 @@ impl Box3 {
     pub(crate) fn half_area(&self) -> f64 {
         let e = self.extent().as_dvec3();
         e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
+    /// The bounds of the (doubled) centroids of `refs`, in one pass (on rayon at or above
+    /// `parallel`; min and max give the same box in any order).
+    pub(crate) fn centroids_of(refs: &[PrimRef], parallel: usize) -> Box3 {
+        use rayon::prelude::*;
+        let fold = |b: Box3, p: &PrimRef| b.grow(p.centroid2());
+        if refs.len() >= parallel {
+            refs.par_chunks(8192)
+                .map(|c| c.iter().fold(Box3::EMPTY, fold))
+                .reduce(|| Box3::EMPTY, |a, b| a.union(&b))
+        } else {
+            refs.iter().fold(Box3::EMPTY, fold)
+        }
     }
 
     pub(crate) fn to_aabb(self) -> Aabb {
