@@ -490,12 +490,13 @@ thread_local! {
 }
 
 /// Any hit will do, so no sorting (as Embree's occlusion traversal): returns the child in the
-/// lowest slot of `mask` and pushes the others to pop in slot order.
+/// lowest slot of `mask` and pushes the others to pop in slot order. Their entry distances are
+/// not kept: an any-hit walk ends at its first hit, so `t_max` never shrinks and no pushed
+/// subtree is ever skipped (the pop does not look at them either).
 #[inline(always)]
 fn first_in_slot_order<const W: usize>(
     n: &WideNode<W>,
     mask: u32,
-    entry: &[f32; W],
     stack: &mut Stack,
     sp: &mut usize,
 ) -> ChildRef {
@@ -504,7 +505,7 @@ fn first_in_slot_order<const W: usize>(
     while rest != 0 {
         let i = 31 - rest.leading_zeros() as usize;
         rest &= !(1 << i);
-        stack[*sp] = (n.child[i], entry[i]);
+        stack[*sp] = (n.child[i], 0.0);
         *sp += 1;
     }
     n.child[first]
@@ -625,7 +626,7 @@ impl<const W: usize> BvhWide<W> {
                 if mask != 0 {
                     self.prefetch_children(n, mask);
                     r = if ANY_HIT {
-                        first_in_slot_order(n, mask, &entry, stack, &mut sp)
+                        first_in_slot_order(n, mask, stack, &mut sp)
                     } else {
                         nearest_first(n, mask, &entry, stack, &mut sp)
                     };
@@ -639,7 +640,7 @@ impl<const W: usize> BvhWide<W> {
                 }
                 sp -= 1;
                 let (next, t_entry) = stack[sp];
-                if t_entry <= best_t {
+                if ANY_HIT || t_entry <= best_t {
                     r = next;
                     continue 'walk;
                 }
