@@ -9,7 +9,7 @@
 //! registers saves one `movemask`), so it is not a separate kernel.
 
 use crate::wide::{BvhWide, NodeKernel, Stack, WideNode};
-use raybench_accel::{CounterSink, Hit};
+use raybench_accel::{CounterSink, Hit, NoCount};
 use raybench_geom::Ray;
 use std::arch::x86_64::*;
 
@@ -127,4 +127,57 @@ pub(crate) fn walk_ray<const W: usize, const ANY_HIT: bool, C: CounterSink>(
 ) -> Option<Hit> {
     // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
     unsafe { walk_ray_avx2::<W, ANY_HIT, C>(bvh, k, ray, stack, c) }
+}
+
+/// Closest hits of a batch of rays in one AVX2 function: the loop lives inside the
+/// `#[target_feature]` code, so a ray pays no call, prologue or kernel dispatch of its own.
+#[target_feature(enable = "avx2")]
+fn intersect_all_avx2<const W: usize>(
+    bvh: &BvhWide<W>,
+    k: Avx2Nodes,
+    rays: &[Ray],
+    out: &mut [Option<Hit>],
+    stack: &mut Stack,
+) {
+    for (o, ray) in out.iter_mut().zip(rays) {
+        *o = bvh.walk_ray::<false, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount);
+    }
+}
+
+/// Any-hit answers of a batch of rays, as [`intersect_all_avx2`].
+#[target_feature(enable = "avx2")]
+fn occluded_all_avx2<const W: usize>(
+    bvh: &BvhWide<W>,
+    k: Avx2Nodes,
+    rays: &[Ray],
+    out: &mut [bool],
+    stack: &mut Stack,
+) {
+    for (o, ray) in out.iter_mut().zip(rays) {
+        *o = bvh
+            .walk_ray::<true, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount)
+            .is_some();
+    }
+}
+
+pub(crate) fn intersect_all<const W: usize>(
+    bvh: &BvhWide<W>,
+    k: Avx2Nodes,
+    rays: &[Ray],
+    out: &mut [Option<Hit>],
+    stack: &mut Stack,
+) {
+    // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
+    unsafe { intersect_all_avx2(bvh, k, rays, out, stack) }
+}
+
+pub(crate) fn occluded_all<const W: usize>(
+    bvh: &BvhWide<W>,
+    k: Avx2Nodes,
+    rays: &[Ray],
+    out: &mut [bool],
+    stack: &mut Stack,
+) {
+    // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
+    unsafe { occluded_all_avx2(bvh, k, rays, out, stack) }
 }

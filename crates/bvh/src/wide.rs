@@ -783,14 +783,24 @@ impl<const W: usize> Accel for BvhWide<W> {
         out: &mut [Option<Hit>],
     ) {
         let mut stack = new_stack();
-        for (o, ray) in out.iter_mut().zip(&rays[first..]) {
+        let rays = &rays[first..];
+        #[cfg(target_arch = "x86_64")]
+        if let Some(k) = self.avx2 {
+            return crate::avx2::intersect_all(self, k, rays, out, &mut stack);
+        }
+        for (o, ray) in out.iter_mut().zip(rays) {
             *o = self.trace::<false, _>(ray, &mut stack, &mut NoCount);
         }
     }
 
     fn occluded_prepared(&self, rays: &[Ray], _: &PreparedRays, first: usize, out: &mut [bool]) {
         let mut stack = new_stack();
-        for (o, ray) in out.iter_mut().zip(&rays[first..]) {
+        let rays = &rays[first..];
+        #[cfg(target_arch = "x86_64")]
+        if let Some(k) = self.avx2 {
+            return crate::avx2::occluded_all(self, k, rays, out, &mut stack);
+        }
+        for (o, ray) in out.iter_mut().zip(rays) {
             *o = self
                 .trace::<true, _>(ray, &mut stack, &mut NoCount)
                 .is_some();
