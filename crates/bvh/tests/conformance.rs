@@ -1,6 +1,6 @@
 //! The shared conformance suite for every BVH variant, `validate()` after every build.
 
-use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, BvhWide, WideParams};
 use raybench_testkit::conformance;
 
 fn check(params: BvhParams) {
@@ -67,22 +67,23 @@ fn wide_params(width: u32) -> [WideParams; 2] {
     [WideParams::for_width(width), tiny]
 }
 
-#[test]
-fn wide_conforms() {
-    for params in wide_params(8) {
-        let counts = conformance::<Bvh8>(&params, &|b, mesh| b.validate(mesh));
+/// The shared suite on a `W`-wide tree, both parameter sets.
+fn wide_conforms_at<const W: usize>() {
+    for params in wide_params(W as u32) {
+        let counts = conformance::<BvhWide<W>>(&params, &|b, mesh| b.validate(mesh));
         assert_eq!(counts.mismatch, 0, "{params:?}");
         assert!(counts.exact > 10_000, "{counts:?}");
     }
 }
 
 #[test]
+fn wide_conforms() {
+    wide_conforms_at::<8>();
+}
+
+#[test]
 fn four_wide_conforms() {
-    for params in wide_params(4) {
-        let counts = conformance::<Bvh4>(&params, &|b, mesh| b.validate(mesh));
-        assert_eq!(counts.mismatch, 0, "{params:?}");
-        assert!(counts.exact > 10_000, "{counts:?}");
-    }
+    wide_conforms_at::<4>();
 }
 
 /// A tree is built only with its own width: the knob in the report is the tree's shape.
