@@ -700,6 +700,12 @@ impl<const W: usize> Accel for BvhWide<W> {
     type Params = WideParams;
 
     fn build(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<BvhWide<W>, BuildError> {
+        if W > MAX_WIDTH || !W.is_multiple_of(4) {
+            return Err(BuildError::Unsupported(format!(
+                "a {W}-wide BVH (4 or 8 children: the SIMD node tests take four lanes at a time \
+                 and the stacks hold {MAX_WIDTH})"
+            )));
+        }
         if params.width as usize != W {
             return Err(BuildError::Unsupported(format!(
                 "width {} in a {W}-wide BVH",
