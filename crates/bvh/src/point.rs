@@ -60,6 +60,21 @@ fn binary_child_distances(p: &SplatPoint, n: &Node) -> [f32; 2] {
     [d[0], d[1]]
 }
 
+/// The most recently pushed subtree whose squared distance is within `bound` (both walks push
+/// the nearer subtrees last); the farther ones popped on the way are dropped for good, since
+/// the bound only shrinks.
+#[inline(always)]
+fn pop_within(stack: &[(ChildRef, f32)], sp: &mut usize, bound: f32) -> Option<ChildRef> {
+    while *sp > 0 {
+        *sp -= 1;
+        let (r, d2) = stack[*sp];
+        if d2 <= bound {
+            return Some(r);
+        }
+    }
+    None
+}
+
 /// The closest-point walk of the binary [`Bvh`], counting into `c` (a no-op for `NoCount`).
 pub(crate) fn closest_point_binary<C: CounterSink>(
     bvh: &Bvh,
@@ -76,7 +91,7 @@ pub(crate) fn closest_point_binary<C: CounterSink>(
     let mut stack = [(ChildRef::default(), 0f32); MAX_DEPTH];
     let mut sp = 0;
     let mut next = Some(bvh.root);
-    'walk: loop {
+    loop {
         while let Some(r) = next.take() {
             if r.is_leaf() {
                 c.leaf();
@@ -96,15 +111,10 @@ pub(crate) fn closest_point_binary<C: CounterSink>(
                 }
             }
         }
-        while sp > 0 {
-            sp -= 1;
-            let (r, d2) = stack[sp];
-            if d2 <= nearest.bound_d2() {
-                next = Some(r);
-                continue 'walk;
-            }
+        next = pop_within(&stack, &mut sp, nearest.bound_d2());
+        if next.is_none() {
+            return nearest.into_hit();
         }
-        return nearest.into_hit();
     }
 }
 
@@ -186,7 +196,7 @@ pub(crate) fn closest_point_wide<const W: usize, C: CounterSink>(
     let mut sp = 0;
     let mut next = Some(bvh.root);
     let mut kids = [(ChildRef::default(), 0f32); W];
-    'walk: loop {
+    loop {
         while let Some(r) = next.take() {
             if r.is_leaf() {
                 c.leaf();
@@ -207,15 +217,10 @@ pub(crate) fn closest_point_wide<const W: usize, C: CounterSink>(
             }
             next = Some(kids[0].0);
         }
-        while sp > 0 {
-            sp -= 1;
-            let (r, d2) = stack[sp];
-            if d2 <= nearest.bound_d2() {
-                next = Some(r);
-                continue 'walk;
-            }
+        next = pop_within(&stack, &mut sp, nearest.bound_d2());
+        if next.is_none() {
+            return nearest.into_hit();
         }
-        return nearest.into_hit();
     }
 }
 
