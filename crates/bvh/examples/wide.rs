@@ -5,7 +5,8 @@
 //! Short passes and many rounds make an undisturbed pass likely.
 //!
 //! `cargo run --release -p raybench-bvh --example wide -- ../shared/scenes/stanford-bunny.obj 50000 20`
-//! (scene, rays per workload, rounds, optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round.
+//! (scene: an .obj path or a generator spec such as `hair`; rays per workload; rounds;
+//! optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round.
 
 use raybench_accel::{Accel, PreparedRays};
 use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, NodeSimd, WideParams};
@@ -42,7 +43,12 @@ fn main() {
     let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(50_000);
     let rounds: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);
     let only = args.next(); // one workload's name, to profile it alone
-    let scene = raybench_scenes::load_obj(std::path::Path::new(&path)).expect("scene loads");
+    // An .obj path, or a generator spec as the harness takes them (`hair`, `soup:triangles=5000`).
+    let scene = if path.ends_with(".obj") {
+        raybench_scenes::load_obj(std::path::Path::new(&path)).expect("scene loads")
+    } else {
+        raybench_scenes::generate(&path, 1).expect("scene generates")
+    };
     let mesh = Arc::clone(&scene.mesh);
     let bounds = mesh.bounds();
 

@@ -173,21 +173,21 @@ impl Tri4 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use raybench_geom::{Triangle, Vec3};
 
     /// A small deterministic generator (SplitMix64), so the test needs no dependency.
-    struct Rng(u64);
+    pub(crate) struct Rng(pub u64);
     impl Rng {
-        fn next(&mut self) -> f32 {
+        pub(crate) fn next(&mut self) -> f32 {
             self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
             let mut z = self.0;
             z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
             z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
             ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
         }
-        fn point(&mut self, scale: f32) -> Vec3 {
+        pub(crate) fn point(&mut self, scale: f32) -> Vec3 {
             Vec3::new(self.next(), self.next(), self.next()) * (2.0 * scale) - scale
         }
     }

@@ -18,7 +18,9 @@
 //! 2026-11-21; prefetching only the pushed ones gained less).
 //!
 //! Leaves are SIMD packets ([`Tri4`]): the binary builder prices a leaf by the packets of four
-//! it fills (`leaf_block = 4`), and one SSE Möller–Trumbore test answers for four triangles.
+//! it fills (`leaf_block = 4`), and one SSE Möller–Trumbore test answers for four triangles;
+//! with AVX2 a leaf's packets are tested two at a time, eight lanes a pass
+//! ([`crate::avx2`]), with the same answers.
 //! An 8-wide node is tested in one 8-lane AVX2 pass per axis when the CPU has AVX2 (detected
 //! at build time, [`crate::avx2`]) and in two 4-lane SSE passes otherwise; both are the scalar
 //! slab test lane for lane and pass the same conformance tests.
@@ -100,14 +102,15 @@ pub(crate) fn quad<const W: usize>(row: &[f32; W], q: usize) -> &[f32; 4] {
     &row.as_chunks::<4>().0[q]
 }
 
-/// Which instructions test a wide node.
+/// Which instructions test a wide node and its leaves.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum NodeSimd {
     /// AVX2 when the CPU has it (run-time detection), SSE otherwise.
     #[default]
     Auto,
-    /// Two 4-lane SSE passes per axis (the x86-64 baseline; portable code elsewhere).
+    /// 4-lane SSE: one pass per axis and four children, one packet of four triangles a pass
+    /// (the x86-64 baseline; portable code elsewhere).
     Sse,
 }
 
@@ -118,7 +121,8 @@ pub struct WideParams {
     pub binary: BvhParams,
     /// Children per node: 8 ([`Bvh8`]) or 4 ([`Bvh4`]); a tree is built only with its own.
     pub width: u32,
-    /// For 8-wide nodes (4-wide ones always take one 4-lane SSE pass per axis).
+    /// The kernels: with AVX2, 8-wide nodes take one 8-lane pass per axis (4-wide ones keep
+    /// one 4-lane pass) and leaves are tested two packets a pass.
     pub node_simd: NodeSimd,
 }
 
@@ -278,7 +282,7 @@ impl<const W: usize> BvhWide<W> {
         self.packets.iter().flat_map(|p| p.ids)
     }
 
-    /// Whether nodes are tested with the AVX2 kernel (else SSE).
+    /// Whether the AVX2 kernels test nodes and leaves (else SSE).
     pub fn uses_avx2(&self) -> bool {
         #[cfg(target_arch = "x86_64")]
         return self.avx2.is_some();
@@ -429,6 +433,16 @@ pub(crate) trait NodeKernel<const W: usize>: Copy {
     type Ray;
     fn ray(self, ray: &Ray) -> Self::Ray;
     fn test(self, ray: &Self::Ray, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]);
+    /// The packets of one leaf (the first is packet `first` of the tree) against the ray below
+    /// `*best_t`, exactly as [`intersect_packets`] does it; true when an any-hit query may stop.
+    fn leaf<const ANY_HIT: bool>(
+        self,
+        ray: &Self::Ray,
+        packets: &[Tri4],
+        first: usize,
+        best_t: &mut f32,
+        best: &mut Option<(usize, TriHit)>,
+    ) -> bool;
 }
 
 /// The baseline kernel: one 4-lane pass per axis and four children (SSE on x86-64, portable
@@ -442,6 +456,7 @@ pub(crate) struct WideRay {
     origin: [F4; 3],
     inv: [F4; 3],
     near: [bool; 3],
+    ray4: Ray4,
 }
 
 impl<const W: usize> NodeKernel<W> for SseNodes {
@@ -455,7 +470,20 @@ impl<const W: usize> NodeKernel<W> for SseNodes {
             inv: inv.map(F4::splat),
             // -0 counts as negative: its inverse is -inf (bug class B3).
             near: inv.map(|x| x.is_sign_negative()),
+            ray4: Ray4::new(ray),
         }
+    }
+
+    #[inline(always)]
+    fn leaf<const ANY_HIT: bool>(
+        self,
+        ray: &WideRay,
+        packets: &[Tri4],
+        first: usize,
+        best_t: &mut f32,
+        best: &mut Option<(usize, TriHit)>,
+    ) -> bool {
+        intersect_packets::<ANY_HIT>(packets, first, &ray.ray4, best_t, best)
     }
 
     #[inline(always)]
@@ -561,22 +589,19 @@ fn nearest_first<const W: usize>(
     stack[*sp].0
 }
 
-/// Tests the packets of leaf `r` below `*best_t`, keeping the closest hit (as a lane index
-/// `4 * packet + lane`); true when an any-hit query may stop.
+/// Tests a leaf's packets (the first is packet `first` of the tree) one after the other below
+/// `*best_t`, keeping the closest hit (as a lane index `4 * packet + lane`); true when an
+/// any-hit query may stop. A later packet's lane replaces the best hit so far when its
+/// window test `t <= best_t` passes, so on an exact tie the later packet wins.
 #[inline(always)]
-fn intersect_packets<const ANY_HIT: bool, C: CounterSink>(
+pub(crate) fn intersect_packets<const ANY_HIT: bool>(
     packets: &[Tri4],
-    r: ChildRef,
+    first: usize,
     ray: &Ray4,
     best_t: &mut f32,
     best: &mut Option<(usize, TriHit)>,
-    c: &mut C,
 ) -> bool {
-    c.leaf();
-    c.prim_tests(r.count as u64);
-    let first = r.index as usize;
-    let used = (r.count as usize).div_ceil(4);
-    for (k, packet) in packets[first..first + used].iter().enumerate() {
+    for (k, packet) in packets.iter().enumerate() {
         if let Some((lane, h)) = packet.intersect(ray, *best_t) {
             *best_t = h.t;
             *best = Some((4 * (first + k) + lane, h));
@@ -606,20 +631,16 @@ impl<const W: usize> BvhWide<W> {
         let t_min = ray.t_min();
         let mut best_t = ray.t_max();
         let wide = kernel.ray(ray);
-        let ray4 = Ray4::new(ray);
         let mut best: Option<(usize, TriHit)> = None;
         let mut sp = 0;
         let mut r = self.root;
         'walk: loop {
             if r.is_leaf() {
-                if intersect_packets::<ANY_HIT, C>(
-                    &self.packets,
-                    r,
-                    &ray4,
-                    &mut best_t,
-                    &mut best,
-                    c,
-                ) {
+                c.leaf();
+                c.prim_tests(r.count as u64);
+                let first = r.index as usize;
+                let leaf = &self.packets[first..first + (r.count as usize).div_ceil(4)];
+                if kernel.leaf::<ANY_HIT>(&wide, leaf, first, &mut best_t, &mut best) {
                     break 'walk;
                 }
             } else {
@@ -740,10 +761,9 @@ impl<const W: usize> Accel for BvhWide<W> {
             packets,
             mesh,
             #[cfg(target_arch = "x86_64")]
-            // AVX2 tests eight children a pass; four fit one SSE pass.
             avx2: match params.node_simd {
-                NodeSimd::Auto if W.is_multiple_of(8) => crate::avx2::Avx2Nodes::detect(),
-                _ => None,
+                NodeSimd::Auto => crate::avx2::Avx2Nodes::detect(),
+                NodeSimd::Sse => None,
             },
         })
     }
@@ -876,7 +896,7 @@ impl<const W: usize> BvhWide<W> {
             s.refs as f64 / (4 * self.packets.len()).max(1) as f64,
         );
         s.extra
-            .insert("avx2_node_test".into(), self.uses_avx2() as u8 as f64);
+            .insert("avx2_kernels".into(), self.uses_avx2() as u8 as f64);
         s.nodes += s.leaves;
         s.sah_cost = (root_area > 0.0).then_some(sah);
         s

@@ -122,32 +122,49 @@ fn both_widths_share_the_leaves_and_differ_in_depth() {
     assert!(s4.extra["mean_children"] <= 4.0 && s8.extra["mean_children"] > 4.0);
 }
 
-/// The SSE node kernel (what a CPU without AVX2 runs) answers like the AVX2 one: the same
-/// suite, and the same hits and counters ray for ray on a seeded scene.
-#[test]
-fn wide_sse_kernel_conforms_and_matches_the_default() {
+/// The SSE kernels (what a CPU without AVX2 runs) answer like the AVX2 ones, at width `W`:
+/// the same suite, and the same hits and counters ray for ray on a seeded scene, with leaves
+/// small enough for one packet and large enough for several (the AVX2 leaf test takes two
+/// packets a pass).
+fn sse_matches_avx2_at<const W: usize>() {
     use raybench_accel::{Accel, Counters};
-    let sse = Bvh8Params {
+    let sse = WideParams {
         node_simd: raybench_bvh::NodeSimd::Sse,
-        ..Bvh8Params::default()
+        ..WideParams::for_width(W as u32)
     };
-    let counts = conformance::<Bvh8>(&sse, &|b, mesh| b.validate(mesh));
+    let counts = conformance::<BvhWide<W>>(&sse, &|b, mesh| b.validate(mesh));
     assert_eq!(counts.mismatch, 0);
     let mesh = raybench_scenes::generate("teapot:triangles=5000", 1)
         .expect("generates")
         .mesh;
-    let a = Bvh8::build(mesh.clone(), &Bvh8Params::default()).expect("builds");
-    let b = Bvh8::build(mesh.clone(), &sse).expect("builds");
-    assert!(!b.uses_avx2());
-    for ray in raybench_scenes::random_rays(&mesh.bounds(), 5_000, 7) {
-        let (mut ca, mut cb) = (Counters::default(), Counters::default());
-        assert_eq!(
-            a.intersect_counted(&ray, &mut ca),
-            b.intersect_counted(&ray, &mut cb)
-        );
-        assert_eq!(a.occluded(&ray), b.occluded(&ray));
-        assert_eq!(ca, cb, "{ray:?}");
+    for max_leaf_size in [4, 16] {
+        let with = |p: &WideParams| {
+            let mut p = p.clone();
+            p.binary.max_leaf_size = max_leaf_size;
+            BvhWide::<W>::build(mesh.clone(), &p).expect("builds")
+        };
+        let (a, b) = (with(&WideParams::for_width(W as u32)), with(&sse));
+        assert!(!b.uses_avx2());
+        for ray in raybench_scenes::random_rays(&mesh.bounds(), 5_000, 7) {
+            let (mut ca, mut cb) = (Counters::default(), Counters::default());
+            assert_eq!(
+                a.intersect_counted(&ray, &mut ca),
+                b.intersect_counted(&ray, &mut cb)
+            );
+            assert_eq!(a.occluded(&ray), b.occluded(&ray));
+            assert_eq!(ca, cb, "{ray:?}");
+        }
     }
+}
+
+#[test]
+fn wide_sse_kernel_conforms_and_matches_the_default() {
+    sse_matches_avx2_at::<8>();
+}
+
+#[test]
+fn four_wide_sse_kernel_conforms_and_matches_the_default() {
+    sse_matches_avx2_at::<4>();
 }
 
 #[test]
