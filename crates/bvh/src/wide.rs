@@ -142,15 +142,20 @@ impl WideParams {
 impl Default for WideParams {
     fn default() -> Self {
         WideParams {
-            // A packet test costs about one wide node test, as Embree's BVH8 builder prices
-            // them (intersection cost 1 per block of 4, traversal cost 1): 0.25 per triangle
-            // slot. Leaves of up to 16 (four packets) let the SAH stop early where triangles
-            // overlap. Against cost 1 and 8: 2–7 % faster primary, random and shadow rays on
-            // the bunny and conference and 10 % faster builds (this VM, 2026-11-21, best of 15
-            // passes interleaved with embree-medium, under load, so ±5 %).
+            // 0.15 per triangle slot: a packet of four costs 0.6 of a wide node test. Embree's
+            // BVH8 builder prices a packet like one node test (0.25 here), which was 2–7 %
+            // faster than 1 and 8; since the AVX2 leaf test takes two packets a pass, larger
+            // leaves pay. Over the 17 scenes of the default suite, against 0.25 (geometric
+            // means of best-of-6 passes interleaved in one process, this VM, 2026-11-21):
+            // 0.15 primary +3.2 %, random +3.4 %, shadow +2.4 %; 0.125 +2.2–2.9 / +2.6–2.9 /
+            // +1.0–1.4 % (two sweeps); 0.1 and 0.18 less; a leaf cap of 12 nothing. Below 0.15
+            // the SAH cost with the shared constants (which price every triangle alike)
+            // exceeds bvh-binned's on the bunny and the dragon (0.125: 33.4 against 31.3;
+            // 0.15: 30.5). Leaves of up to 16 (four packets) let the SAH stop early where
+            // triangles overlap.
             binary: BvhParams {
                 leaf_block: 4,
-                intersection_cost: 0.25,
+                intersection_cost: 0.15,
                 max_leaf_size: 16,
                 ..BvhParams::binned()
             },
