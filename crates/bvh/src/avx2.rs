@@ -15,8 +15,9 @@
 //! instructions, shadow 9.92M → 9.73M; timed, hair shadow rays 0.80 → 0.93× embree-medium
 //! and soup and grass 3–5 % faster (this VM, 2026-11-21).
 
-use crate::tri4::Tri4;
-use crate::wide::{BvhWide, NodeKernel, Stack, WideNode, quad};
+use crate::simd::F4;
+use crate::tri4::{Tri4, nearest_lane};
+use crate::wide::{BvhWide, NodeKernel, Stack, WideNode, slab_quads};
 use raybench_accel::{CounterSink, Hit, NoCount};
 use raybench_geom::{Ray, TriHit};
 use std::arch::x86_64::*;
@@ -100,42 +101,6 @@ fn test_octs<const W: usize>(
     (mask, entry)
 }
 
-/// [`test_octs`] four children a pass, for 4-wide nodes: the SSE kernel's arithmetic on the
-/// low halves of the splatted ray.
-#[target_feature(enable = "avx2")]
-#[inline]
-fn test_quads<const W: usize>(
-    r: &Avx2Ray,
-    n: &WideNode<W>,
-    t_min: f32,
-    t_max: f32,
-) -> (u32, [f32; W]) {
-    let mut mask = 0;
-    let mut entry = [0.0f32; W];
-    for q in 0..W / 4 {
-        let mut t0 = _mm_set1_ps(t_min);
-        let mut t1 = _mm_set1_ps(t_max);
-        for a in 0..3 {
-            let near = quad(&n.planes[a][r.near[a] as usize], q);
-            let far = quad(&n.planes[a][!r.near[a] as usize], q);
-            // SAFETY: each is a reference to 4 contiguous initialised f32s, and `loadu` has
-            // no alignment requirement.
-            let (near, far) = unsafe { (_mm_loadu_ps(near.as_ptr()), _mm_loadu_ps(far.as_ptr())) };
-            let (o, inv) = (
-                _mm256_castps256_ps128(r.origin[a]),
-                _mm256_castps256_ps128(r.inv[a]),
-            );
-            t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, o), inv), t0);
-            t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, o), inv), t1);
-        }
-        mask |= (_mm_movemask_ps(_mm_cmple_ps(t0, t1)) as u32) << (4 * q);
-        let out: &mut [f32; 4] = &mut entry.as_chunks_mut::<4>().0[q];
-        // SAFETY: `out` is 4 writable f32s; `storeu` has no alignment requirement.
-        unsafe { _mm_storeu_ps(out.as_mut_ptr(), t0) };
-    }
-    (mask, entry)
-}
-
 impl<const W: usize> NodeKernel<W> for Avx2Nodes {
     type Ray = Avx2Ray;
 
@@ -152,7 +117,9 @@ impl<const W: usize> NodeKernel<W> for Avx2Nodes {
             if W.is_multiple_of(8) {
                 test_octs(ray, n, t_min, t_max)
             } else {
-                test_quads(ray, n, t_min, t_max)
+                // 4 wide: the SSE kernel's arithmetic on the low halves of the splatted ray.
+                let low = |v: &[__m256; 3]| v.map(|x| F4::from_m128(_mm256_castps256_ps128(x)));
+                slab_quads(&low(&ray.origin), &low(&ray.inv), ray.near, n, t_min, t_max)
             }
         }
     }
@@ -273,22 +240,6 @@ fn scaled(x: __m256, inv: __m256) -> [f32; 8] {
     out
 }
 
-/// The lane of `bits` with the smallest `t` (the lowest lane on ties), as [`Tri4::intersect`]
-/// picks within a packet.
-#[inline(always)]
-fn nearest(t: &[f32; 8], mut bits: u32) -> usize {
-    let mut best = bits.trailing_zeros() as usize;
-    bits &= bits - 1;
-    while bits != 0 {
-        let i = bits.trailing_zeros() as usize;
-        bits &= bits - 1;
-        if t[i] < t[best] {
-            best = i;
-        }
-    }
-    best
-}
-
 /// [`Tri4::intersect`] for two packets in one pass: the answer of testing `a` and then `b`
 /// with the window shrunk to `a`'s hit, as a lane `0..8` (4.. for `b`) and its hit.
 #[target_feature(enable = "avx2")]
@@ -326,7 +277,7 @@ fn test8(r: &Avx2Ray, a: &Tri4, b: Option<&Tri4>, t_max: f32) -> Option<(usize, 
     }
     let inv = _mm256_div_ps(_mm256_set1_ps(1.0), abs_den);
     let tt = scaled(t, inv);
-    let mut pick = (mask & 0xF != 0).then(|| nearest(&tt, mask & 0xF));
+    let mut pick = (mask & 0xF != 0).then(|| nearest_lane(&tt, mask & 0xF));
     let mut later = mask & 0xF0;
     if let Some(i) = pick
         && later != 0
@@ -335,7 +286,7 @@ fn test8(r: &Avx2Ray, a: &Tri4, b: Option<&Tri4>, t_max: f32) -> Option<(usize, 
         later &= in_window8(t, abs_den, r.t_min, tt[i]);
     }
     if later != 0 {
-        pick = Some(nearest(&tt, later));
+        pick = Some(nearest_lane(&tt, later));
     }
     let (uu, vv) = (scaled(u, inv), scaled(v, inv));
     pick.map(|i| {

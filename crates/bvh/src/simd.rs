@@ -159,6 +159,12 @@ mod imp {
             F4(v.into())
         }
 
+        /// The four lanes of an SSE register (for the AVX2 kernels' 4-lane work).
+        #[inline(always)]
+        pub fn from_m128(v: __m128) -> F4 {
+            F4(v)
+        }
+
         #[inline(always)]
         pub fn to_array(self) -> [f32; 4] {
             let mut out = [0.0f32; 4];

@@ -42,6 +42,22 @@ impl Default for Tri4 {
     }
 }
 
+/// The lane of `bits` (a nonzero lane mask) with the smallest `t`, the lowest lane on ties:
+/// how a packet test picks its hit among lanes.
+#[inline(always)]
+pub(crate) fn nearest_lane(t: &[f32], mut bits: u32) -> usize {
+    let mut best = bits.trailing_zeros() as usize;
+    bits &= bits - 1;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        if t[i] < t[best] {
+            best = i;
+        }
+    }
+    best
+}
+
 /// The ray splatted across four lanes, made once per ray.
 pub(crate) struct Ray4 {
     origin: [F4; 3],
@@ -142,7 +158,7 @@ impl Tri4 {
             .mul(ray.t_min)
             .lt(t)
             .and(t.le(abs_den.mul(F4::splat(t_max))));
-        let mut mask = inside.and(in_window).bits();
+        let mask = inside.and(in_window).bits();
         if mask == 0 {
             return None;
         }
@@ -152,15 +168,7 @@ impl Tri4 {
             u.mul(inv).to_array(),
             v.mul(inv).to_array(),
         );
-        let mut best = mask.trailing_zeros() as usize;
-        mask &= mask - 1;
-        while mask != 0 {
-            let i = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            if t[i] < t[best] {
-                best = i;
-            }
-        }
+        let best = nearest_lane(&t, mask);
         Some((
             best,
             TriHit {

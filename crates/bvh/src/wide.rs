@@ -493,22 +493,37 @@ impl<const W: usize> NodeKernel<W> for SseNodes {
 
     #[inline(always)]
     fn test(self, r: &WideRay, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]) {
-        let mut mask = 0;
-        let mut entry = [0.0; W];
-        for q in 0..W / 4 {
-            let mut t0 = F4::splat(t_min);
-            let mut t1 = F4::splat(t_max);
-            for a in 0..3 {
-                let near = F4::load(quad(&n.planes[a][r.near[a] as usize], q));
-                let far = F4::load(quad(&n.planes[a][!r.near[a] as usize], q));
-                t0 = near.sub(r.origin[a]).mul(r.inv[a]).max_keep(t0);
-                t1 = far.sub(r.origin[a]).mul(r.inv[a]).min_keep(t1);
-            }
-            mask |= t0.le_mask(t1) << (4 * q);
-            entry[4 * q..4 * q + 4].copy_from_slice(&t0.to_array());
-        }
-        (mask, entry)
+        slab_quads(&r.origin, &r.inv, r.near, n, t_min, t_max)
     }
+}
+
+/// The slab test of a node's children four lanes a pass, for a ray splatted as `origin` and
+/// `inv` whose near planes lie on the sides `near` (the SSE kernel, and the AVX2 kernel's
+/// 4-wide nodes).
+#[inline(always)]
+pub(crate) fn slab_quads<const W: usize>(
+    origin: &[F4; 3],
+    inv: &[F4; 3],
+    near: [bool; 3],
+    n: &WideNode<W>,
+    t_min: f32,
+    t_max: f32,
+) -> (u32, [f32; W]) {
+    let mut mask = 0;
+    let mut entry = [0.0; W];
+    for q in 0..W / 4 {
+        let mut t0 = F4::splat(t_min);
+        let mut t1 = F4::splat(t_max);
+        for a in 0..3 {
+            let near_planes = F4::load(quad(&n.planes[a][near[a] as usize], q));
+            let far_planes = F4::load(quad(&n.planes[a][!near[a] as usize], q));
+            t0 = near_planes.sub(origin[a]).mul(inv[a]).max_keep(t0);
+            t1 = far_planes.sub(origin[a]).mul(inv[a]).min_keep(t1);
+        }
+        mask |= t0.le_mask(t1) << (4 * q);
+        entry[4 * q..4 * q + 4].copy_from_slice(&t0.to_array());
+    }
+    (mask, entry)
 }
 
 type Entry = (ChildRef, f32);
