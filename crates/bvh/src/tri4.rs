@@ -60,7 +60,8 @@ pub(crate) fn nearest_lane(t: &[f32], mut bits: u32) -> usize {
 
 /// The ray splatted across four lanes, made once per ray.
 pub(crate) struct Ray4 {
-    origin: [F4; 3],
+    /// Also the SSE node test's splatted origin.
+    pub(crate) origin: [F4; 3],
     dir: [F4; 3],
     t_min: F4,
 }

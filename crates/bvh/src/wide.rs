@@ -455,13 +455,13 @@ pub(crate) trait NodeKernel<const W: usize>: Copy {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SseNodes;
 
-/// The ray as [`SseNodes`] needs it: origin and inverse direction splatted, and per axis which
-/// stored side (min or max) holds the near planes.
+/// The ray as [`SseNodes`] needs it: the packet test's splatted ray (whose origin the node
+/// test shares), the inverse direction splatted, and per axis which stored side (min or max)
+/// holds the near planes.
 pub(crate) struct WideRay {
-    origin: [F4; 3],
+    ray4: Ray4,
     inv: [F4; 3],
     near: [bool; 3],
-    ray4: Ray4,
 }
 
 impl<const W: usize> NodeKernel<W> for SseNodes {
@@ -471,7 +471,6 @@ impl<const W: usize> NodeKernel<W> for SseNodes {
     fn ray(self, ray: &Ray) -> WideRay {
         let inv = ray.inv_dir().to_array();
         WideRay {
-            origin: ray.origin().to_array().map(F4::splat),
             inv: inv.map(F4::splat),
             // -0 counts as negative: its inverse is -inf (bug class B3).
             near: inv.map(|x| x.is_sign_negative()),
@@ -493,7 +492,7 @@ impl<const W: usize> NodeKernel<W> for SseNodes {
 
     #[inline(always)]
     fn test(self, r: &WideRay, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]) {
-        slab_quads(&r.origin, &r.inv, r.near, n, t_min, t_max)
+        slab_quads(&r.ray4.origin, &r.inv, r.near, n, t_min, t_max)
     }
 }
 
