@@ -175,8 +175,8 @@ impl Accel for Bvh {
             )));
         }
         let flat = build::build(&mesh, params)?;
-        let triangles = flat
-            .prim_ids
+        let prim_ids = flat.prim_ids();
+        let triangles = prim_ids
             .iter()
             .map(|&i| MollerTriangle::new(&mesh.triangle(i as usize)))
             .collect();
@@ -187,7 +187,7 @@ impl Accel for Bvh {
             root: flat.root,
             root_bounds: flat.root_bounds,
             triangles,
-            prim_ids: flat.prim_ids,
+            prim_ids,
             mesh,
         })
     }

@@ -5,7 +5,11 @@
 //! Collapse (as in Wald et al. 2008, "Getting rid of packets", and Embree's BVH4/BVH8
 //! builders): each wide node starts from a binary node's two children and repeatedly opens the
 //! child with the largest surface area — the one a ray is most likely to enter — until it has
-//! `W` children or only leaves remain. Leaves are the binary tree's leaves, unchanged. The
+//! `W` children or only leaves remain; slots still empty then are filled by splitting the
+//! largest leaves of more than one packet in two (`fill_slots`, as Embree's builder splits
+//! every child until the node is full: over the 17 default scenes shadow rays +2.3–2.8 %,
+//! primary −0.1 to +1.0 %, random +0.4–0.9 % in three sweeps, and the SAH cost with the
+//! shared constants 10–35 % lower, this VM, 2026-11-21). The
 //! wide tree has about a third (8 wide) or half (4 wide) of the binary tree's depth, so a ray
 //! walks fewer, wider nodes: fewer dependent memory fetches. The trade-off between the widths:
 //! a 4-wide node is two cache lines and one 4-lane SSE test per axis, an 8-wide node four
@@ -26,7 +30,7 @@
 //! slab test lane for lane and pass the same conformance tests.
 
 use crate::BvhParams;
-use crate::build;
+use crate::build::{self, Box3, PrimRef};
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::simd::{F4, prefetch};
 use crate::tri4::{NO_PRIM, Ray4, Tri4};
@@ -124,6 +128,9 @@ pub struct WideParams {
     /// The kernels: with AVX2, 8-wide nodes take one 8-lane pass per axis (4-wide ones keep
     /// one 4-lane pass) and leaves are tested two packets a pass.
     pub node_simd: NodeSimd,
+    /// Split leaves of more than one packet into the slots a node would leave empty (see
+    /// [`collapse`]); off, the wide tree has exactly the binary tree's leaves.
+    pub fill_slots: bool,
 }
 
 /// The 8-wide tree's knobs (the name the reports and tests have used since issue 8 began).
@@ -153,7 +160,15 @@ impl Default for WideParams {
             // exceeds bvh-binned's on the bunny and the dragon (0.125: 33.4 against 31.3;
             // 0.15: 30.5). Leaves of up to 16 (four packets) let the SAH stop early where
             // triangles overlap.
+            //
+            // 64 bins, not bvh-binned's 32: over the 17 default scenes, best of 10 passes
+            // interleaved in one process (this VM, 2026-11-21), primary +2.1 % and +1.6 %,
+            // random +0.9 % and -0.8 %, shadow +1.8 % and -0.4 % in two sweeps; the steady
+            // part is the teapot in the stadium's close-up, +14-17 % on primary rays (its
+            // 219,956 centroids spread over the stadium leave the teapot in one bin of 32 for
+            // more levels). 128 and 256 bins gained no more.
             binary: BvhParams {
+                bins: 64,
                 leaf_block: 4,
                 intersection_cost: 0.15,
                 max_leaf_size: 16,
@@ -161,6 +176,7 @@ impl Default for WideParams {
             },
             width: MAX_WIDTH as u32,
             node_simd: NodeSimd::Auto,
+            fill_slots: true,
         }
     }
 }
@@ -215,10 +231,77 @@ fn pack_leaves(mesh: &TriangleMesh, prim_ids: &[u32], leaves: &[ChildRef]) -> Ve
         .collect()
 }
 
+/// The binary tree's leaves, which the collapse may split: the builder's triangle records in
+/// leaf order (each leaf a range, reordered in place when the leaf is split).
+struct Leaves<'a> {
+    fill_slots: bool,
+    refs: &'a mut [PrimRef],
+    /// Scratch for one split: the cost of each right-hand half.
+    right: Vec<f64>,
+}
+
+/// Leaves of more triangles than this (one packet) may be split to fill a node's empty slots.
+const SPLIT_LEAVES_ABOVE: u32 = 4;
+
+impl Leaves<'_> {
+    /// Splits leaf `r` in two, forced (as Embree's wide builder splits every child of more than
+    /// one block until the node is full): its triangles sorted by centroid on the axis where the
+    /// centroids spread most, cut where `area × packets` summed over both halves is least
+    /// (first on ties), so each half is a range. One axis, not three: the build is sequential
+    /// here, and three sorts made it about a third slower on the bunny. Deterministic: ties in
+    /// the sort go by mesh index.
+    fn split(&mut self, r: ChildRef) -> [(ChildRef, Aabb); 2] {
+        let refs = &mut self.refs[r.index as usize..(r.index + r.count) as usize];
+        let spread = refs
+            .iter()
+            .fold(Box3::EMPTY, |b, p| b.grow(p.centroid2()))
+            .extent();
+        let axis = spread.max_position();
+        refs.sort_unstable_by(|a, b| {
+            a.centroid2_on(axis)
+                .total_cmp(&b.centroid2_on(axis))
+                .then(a.id().cmp(&b.id()))
+        });
+        let packets = |k: usize| k.div_ceil(4) as f64;
+        let n = refs.len();
+        self.right.resize(n, 0.0);
+        let mut acc = Box3::EMPTY;
+        for k in (1..n).rev() {
+            acc = acc.union(&refs[k].bounds());
+            self.right[k] = acc.half_area() * packets(n - k);
+        }
+        let (mut best, mut k) = (f64::INFINITY, 1);
+        let mut acc = Box3::EMPTY;
+        for at in 1..n {
+            acc = acc.union(&refs[at - 1].bounds());
+            let cost = acc.half_area() * packets(at) + self.right[at];
+            if cost < best {
+                (best, k) = (cost, at);
+            }
+        }
+        let half = |range: &[PrimRef], index: u32| {
+            let b = range.iter().fold(Box3::EMPTY, |b, p| b.union(&p.bounds()));
+            let r = ChildRef {
+                index,
+                count: range.len() as u32,
+            };
+            (r, b.to_aabb())
+        };
+        [
+            half(&refs[..k], r.index),
+            half(&refs[k..], r.index + k as u32),
+        ]
+    }
+}
+
 /// Collapses the binary subtree `r` into wide nodes appended to `out` depth-first; `leaf`
-/// turns each binary leaf into its wide reference, in depth-first order.
+/// turns each binary leaf into its wide reference, in depth-first order. Slots left empty
+/// once no interior child remains to open are filled by splitting the largest leaves of more
+/// than one packet: the node test costs the same however many slots are used, and the
+/// smaller leaves cull more triangles.
 fn collapse<const W: usize>(
     binary: &[Node],
+    leaves: &mut Leaves,
     r: ChildRef,
     out: &mut Vec<WideNode<W>>,
     leaf: &mut impl FnMut(ChildRef) -> ChildRef,
@@ -232,27 +315,46 @@ fn collapse<const W: usize>(
     kids[0] = (n.child[0], n.child_bounds(0));
     kids[1] = (n.child[1], n.child_bounds(1));
     let mut len = 2;
+    // The largest child (first on ties: deterministic) that `openable` accepts.
+    let largest = |kids: &[(ChildRef, Aabb)], openable: &dyn Fn(ChildRef) -> bool| {
+        (0..kids.len())
+            .filter(|&i| openable(kids[i].0))
+            .max_by(|&a, &b| {
+                kids[a]
+                    .1
+                    .surface_area()
+                    .total_cmp(&kids[b].1.surface_area())
+                    .then(b.cmp(&a))
+            })
+    };
     while len < W {
-        // Open the interior child with the largest area (first such on ties: deterministic).
-        let Some(i) = (0..len).filter(|&i| !kids[i].0.is_leaf()).max_by(|&a, &b| {
-            kids[a]
-                .1
-                .surface_area()
-                .total_cmp(&kids[b].1.surface_area())
-                .then(b.cmp(&a))
-        }) else {
+        // Open the interior child with the largest area, else split the largest leaf.
+        let two = if let Some(i) = largest(&kids[..len], &|c| !c.is_leaf()) {
+            let m = &binary[kids[i].0.index as usize];
+            (
+                i,
+                [
+                    (m.child[0], m.child_bounds(0)),
+                    (m.child[1], m.child_bounds(1)),
+                ],
+            )
+        } else if let Some(i) = largest(&kids[..len], &|c| {
+            leaves.fill_slots && c.is_leaf() && c.count > SPLIT_LEAVES_ABOVE
+        }) {
+            (i, leaves.split(kids[i].0))
+        } else {
             break;
         };
-        let m = &binary[kids[i].0.index as usize];
+        let (i, [a, b]) = two;
         kids.copy_within(i + 1..len, i + 2);
-        kids[i] = (m.child[0], m.child_bounds(0));
-        kids[i + 1] = (m.child[1], m.child_bounds(1));
+        kids[i] = a;
+        kids[i + 1] = b;
         len += 1;
     }
     let at = out.len();
     out.push(WideNode::empty());
     for (slot, (child, bounds)) in kids[..len].iter().enumerate() {
-        let r = collapse(binary, *child, out, leaf);
+        let r = collapse(binary, leaves, *child, out, leaf);
         out[at].set_child(slot, bounds, r);
     }
     ChildRef {
@@ -752,16 +854,21 @@ impl<const W: usize> Accel for BvhWide<W> {
                 params.width
             )));
         }
-        let flat = build::build(&mesh, &params.binary)?;
+        let mut flat = build::build(&mesh, &params.binary)?;
         let mut nodes = Vec::with_capacity(flat.nodes.len() / 3 + 1);
         // The collapse only numbers the leaves' packets; they are filled afterwards, in
         // parallel.
         let mut leaves = Vec::new();
         let mut next_packet = 0u32;
-        let root = if flat.prim_ids.is_empty() {
+        let root = if flat.refs.is_empty() {
             ChildRef::default()
         } else {
-            collapse(&flat.nodes, flat.root, &mut nodes, &mut |r| {
+            let mut split = Leaves {
+                fill_slots: params.fill_slots,
+                refs: &mut flat.refs,
+                right: Vec::new(),
+            };
+            collapse(&flat.nodes, &mut split, flat.root, &mut nodes, &mut |r| {
                 leaves.push(r);
                 let index = next_packet;
                 next_packet += r.count.div_ceil(4);
@@ -771,7 +878,7 @@ impl<const W: usize> Accel for BvhWide<W> {
                 }
             })
         };
-        let packets = pack_leaves(&mesh, &flat.prim_ids, &leaves);
+        let packets = pack_leaves(&mesh, &flat.prim_ids(), &leaves);
         Ok(BvhWide {
             params: params.clone(),
             nodes,

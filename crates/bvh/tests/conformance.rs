@@ -106,20 +106,69 @@ fn a_width_other_than_the_trees_is_refused() {
 }
 
 /// Collapsing the same binary tree to 4 and to 8 children keeps every triangle in the same
-/// leaves: both report the same leaves and references, and the 8-wide tree is shallower.
+/// leaves (with the slots left unfilled): both report the same leaves and references, and the
+/// 8-wide tree is shallower and fuller.
 #[test]
 fn both_widths_share_the_leaves_and_differ_in_depth() {
     use raybench_accel::Accel;
     let mesh = raybench_scenes::generate("teapot:triangles=20000", 1)
         .expect("generates")
         .mesh;
-    let four = Bvh4::build(mesh.clone(), &WideParams::for_width(4)).expect("builds");
-    let eight = Bvh8::build(mesh.clone(), &WideParams::for_width(8)).expect("builds");
+    let unfilled = |width| WideParams {
+        fill_slots: false,
+        ..WideParams::for_width(width)
+    };
+    let four = Bvh4::build(mesh.clone(), &unfilled(4)).expect("builds");
+    let eight = Bvh8::build(mesh.clone(), &unfilled(8)).expect("builds");
     let (s4, s8) = (four.build_stats(), eight.build_stats());
     assert_eq!((s4.leaves, s4.refs), (s8.leaves, s8.refs));
     assert!(s8.max_depth < s4.max_depth, "{s4:?} {s8:?}");
     assert!(four.nodes().len() > eight.nodes().len());
-    assert!(s4.extra["mean_children"] <= 4.0 && s8.extra["mean_children"] > 4.0);
+    // The 8-wide nodes hold more children than the 4-wide ones on average (not always more
+    // than four: a binary node whose children are both leaves stays a node of two).
+    let children = |s: &raybench_accel::BuildStats| s.extra["mean_children"];
+    assert!(
+        children(&s4) <= 4.0 && children(&s8) > children(&s4),
+        "{s4:?} {s8:?}"
+    );
+}
+
+/// Filling a node's empty slots by splitting leaves keeps the interior nodes and every
+/// triangle, makes more and smaller leaves and fuller nodes, and lowers the SAH cost; the
+/// filled tree validates. At both widths, on three kinds of scene.
+#[test]
+fn filling_slots_splits_leaves_and_lowers_the_sah() {
+    fn check<const W: usize>(spec: &str) {
+        use raybench_accel::Accel;
+        let mesh = raybench_scenes::generate(spec, 1).expect("generates").mesh;
+        let with = |fill_slots| {
+            let p = WideParams {
+                fill_slots,
+                ..WideParams::for_width(W as u32)
+            };
+            BvhWide::<W>::build(mesh.clone(), &p).expect("builds")
+        };
+        let (filled, plain) = (with(true), with(false));
+        filled.validate(&mesh).expect("the filled tree validates");
+        let (f, p) = (filled.build_stats(), plain.build_stats());
+        let context = format!("{spec}, {W} wide: filled {f:?}, plain {p:?}");
+        assert_eq!(filled.nodes().len(), plain.nodes().len(), "{context}");
+        assert_eq!(f.refs, p.refs, "{context}");
+        assert!(f.leaves > p.leaves, "{context}");
+        assert!(
+            f.extra["mean_children"] > p.extra["mean_children"],
+            "{context}"
+        );
+        assert!(f.sah_cost < p.sah_cost, "{context}");
+    }
+    for spec in [
+        "teapot:triangles=20000",
+        "soup:triangles=5000",
+        "grass:density=20",
+    ] {
+        check::<8>(spec);
+        check::<4>(spec);
+    }
 }
 
 /// The SSE kernels (what a CPU without AVX2 runs) answer like the AVX2 ones, at width `W`:

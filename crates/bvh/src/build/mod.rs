@@ -25,7 +25,8 @@ pub use split::MAX_BINS;
 
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::{Builder, BvhParams};
-use prim::{MAX_PRIMS, PrimRef, Ranged};
+pub(crate) use prim::{Box3, PrimRef};
+use prim::{MAX_PRIMS, Ranged};
 use raybench_accel::{BuildError, BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use raybench_geom::{Aabb, TriangleMesh};
 use rayon::prelude::*;
@@ -34,7 +35,9 @@ use split::{PARALLEL_BINNING, Scratch, Split, binned_split, median_split, sweep_
 /// A built and flattened tree.
 pub(crate) struct Flat {
     pub nodes: Vec<Node>,
-    pub prim_ids: Vec<u32>,
+    /// Every triangle's record (box and mesh index), in leaf order: leaf `{ index, count }`
+    /// holds `refs[index..index + count]`.
+    pub refs: Vec<PrimRef>,
     pub root: ChildRef,
     pub root_bounds: Aabb,
 }
@@ -61,7 +64,7 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
     if n == 0 {
         return Ok(Flat {
             nodes: Vec::new(),
-            prim_ids: Vec::new(),
+            refs: Vec::new(),
             root: ChildRef::default(),
             root_bounds: Aabb::EMPTY,
         });
@@ -77,7 +80,7 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
     let root = part.flatten(&mut nodes);
     let root_bounds = whole.bounds.to_aabb();
     Ok(Flat {
-        prim_ids: refs.iter().map(PrimRef::id).collect(),
+        refs,
         nodes,
         root,
         root_bounds,
@@ -94,6 +97,13 @@ enum Part {
         bounds: [Aabb; 2],
         children: Box<(Part, Part)>,
     },
+}
+
+impl Flat {
+    /// The mesh index of every triangle, in leaf order.
+    pub fn prim_ids(&self) -> Vec<u32> {
+        self.refs.iter().map(PrimRef::id).collect()
+    }
 }
 
 impl Part {
