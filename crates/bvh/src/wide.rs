@@ -231,131 +231,222 @@ fn pack_leaves(mesh: &TriangleMesh, prim_ids: &[u32], leaves: &[ChildRef]) -> Ve
         .collect()
 }
 
-/// The binary tree's leaves, which the collapse may split: the builder's triangle records in
-/// leaf order (each leaf a range, reordered in place when the leaf is split).
-struct Leaves<'a> {
+/// What every collapse task reads: the binary tree, the number of triangles under each of its
+/// interior nodes (a subtree's triangles are one range of the builder's records), and whether
+/// empty slots are filled.
+struct Binary<'a> {
+    nodes: &'a [Node],
+    sizes: Vec<u32>,
     fill_slots: bool,
-    refs: &'a mut [PrimRef],
-    /// Scratch for one split: the cost of each right-hand half.
-    right: Vec<f64>,
 }
 
 /// Leaves of more triangles than this (one packet) may be split to fill a node's empty slots.
 const SPLIT_LEAVES_ABOVE: u32 = 4;
 
-impl Leaves<'_> {
-    /// Splits leaf `r` in two, forced (as Embree's wide builder splits every child of more than
-    /// one block until the node is full): its triangles sorted by centroid on the axis where the
-    /// centroids spread most, cut where `area × packets` summed over both halves is least
-    /// (first on ties), so each half is a range. One axis, not three: the build is sequential
-    /// here, and three sorts made it about a third slower on the bunny. Deterministic: ties in
-    /// the sort go by mesh index.
-    fn split(&mut self, r: ChildRef) -> [(ChildRef, Aabb); 2] {
-        let refs = &mut self.refs[r.index as usize..(r.index + r.count) as usize];
-        let spread = refs
-            .iter()
-            .fold(Box3::EMPTY, |b, p| b.grow(p.centroid2()))
-            .extent();
-        let axis = spread.max_position();
-        refs.sort_unstable_by(|a, b| {
-            a.centroid2_on(axis)
-                .total_cmp(&b.centroid2_on(axis))
-                .then(a.id().cmp(&b.id()))
-        });
-        let packets = |k: usize| k.div_ceil(4) as f64;
-        let n = refs.len();
-        self.right.resize(n, 0.0);
-        let mut acc = Box3::EMPTY;
-        for k in (1..n).rev() {
-            acc = acc.union(&refs[k].bounds());
-            self.right[k] = acc.half_area() * packets(n - k);
+/// Subtrees of at least this many triangles collapse their children's subtrees on rayon.
+const PARALLEL_COLLAPSE: usize = 4096;
+
+impl Binary<'_> {
+    fn new(nodes: &[Node], fill_slots: bool) -> Binary<'_> {
+        let mut sizes = vec![0u32; nodes.len()];
+        // Children follow their parent in the depth-first array: fill in sizes bottom-up.
+        for i in (0..nodes.len()).rev() {
+            sizes[i] = nodes[i]
+                .child
+                .iter()
+                .map(|c| {
+                    if c.is_leaf() {
+                        c.count
+                    } else {
+                        sizes[c.index as usize]
+                    }
+                })
+                .sum();
         }
-        let (mut best, mut k) = (f64::INFINITY, 1);
-        let mut acc = Box3::EMPTY;
-        for at in 1..n {
-            acc = acc.union(&refs[at - 1].bounds());
-            let cost = acc.half_area() * packets(at) + self.right[at];
-            if cost < best {
-                (best, k) = (cost, at);
-            }
+        Binary {
+            nodes,
+            sizes,
+            fill_slots,
         }
-        let half = |range: &[PrimRef], index: u32| {
-            let b = range.iter().fold(Box3::EMPTY, |b, p| b.union(&p.bounds()));
-            let r = ChildRef {
-                index,
-                count: range.len() as u32,
-            };
-            (r, b.to_aabb())
+    }
+
+    fn size(&self, r: ChildRef) -> usize {
+        if r.is_leaf() {
+            r.count as usize
+        } else {
+            self.sizes[r.index as usize] as usize
+        }
+    }
+
+    /// The children of the wide node made from binary node `r`, whose triangles are `refs`
+    /// (the first of them record `start`): starting from its two children, the interior child
+    /// with the largest area is opened (first on ties: deterministic) until there are `W` or
+    /// only leaves remain; slots still empty are filled by splitting the largest leaves of more
+    /// than one packet. Children stay in the order of their triangles.
+    fn open<const W: usize>(
+        &self,
+        refs: &mut [PrimRef],
+        start: u32,
+        r: ChildRef,
+    ) -> ([(ChildRef, Aabb); W], usize) {
+        let n = &self.nodes[r.index as usize];
+        // A fixed array, not a Vec: one wide node per call, no allocation.
+        let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
+        kids[0] = (n.child[0], n.child_bounds(0));
+        kids[1] = (n.child[1], n.child_bounds(1));
+        let mut len = 2;
+        let largest = |kids: &[(ChildRef, Aabb)], openable: &dyn Fn(ChildRef) -> bool| {
+            (0..kids.len())
+                .filter(|&i| openable(kids[i].0))
+                .max_by(|&a, &b| {
+                    kids[a]
+                        .1
+                        .surface_area()
+                        .total_cmp(&kids[b].1.surface_area())
+                        .then(b.cmp(&a))
+                })
         };
-        [
-            half(&refs[..k], r.index),
-            half(&refs[k..], r.index + k as u32),
-        ]
+        while len < W {
+            let two = if let Some(i) = largest(&kids[..len], &|c| !c.is_leaf()) {
+                let m = &self.nodes[kids[i].0.index as usize];
+                let halves = [
+                    (m.child[0], m.child_bounds(0)),
+                    (m.child[1], m.child_bounds(1)),
+                ];
+                (i, halves)
+            } else if let Some(i) = largest(&kids[..len], &|c| {
+                self.fill_slots && c.is_leaf() && c.count > SPLIT_LEAVES_ABOVE
+            }) {
+                let leaf = kids[i].0;
+                let at = (leaf.index - start) as usize;
+                let halves = split_leaf(&mut refs[at..at + leaf.count as usize]);
+                (
+                    i,
+                    halves.map(|(k, b)| {
+                        (
+                            ChildRef {
+                                index: leaf.index + k.index,
+                                ..k
+                            },
+                            b,
+                        )
+                    }),
+                )
+            } else {
+                break;
+            };
+            let (i, [a, b]) = two;
+            kids.copy_within(i + 1..len, i + 2);
+            kids[i] = a;
+            kids[i + 1] = b;
+            len += 1;
+        }
+        (kids, len)
     }
 }
 
-/// Collapses the binary subtree `r` into wide nodes appended to `out` depth-first; `leaf`
-/// turns each binary leaf into its wide reference, in depth-first order. Slots left empty
-/// once no interior child remains to open are filled by splitting the largest leaves of more
-/// than one packet: the node test costs the same however many slots are used, and the
-/// smaller leaves cull more triangles.
+/// Splits a leaf's triangles `refs` in two, forced (as Embree's wide builder splits every
+/// child of more than one block until the node is full): sorted by centroid on the axis where
+/// the centroids spread most, cut where `area × packets` summed over both halves is least
+/// (first on ties). One axis, not three: three sorts made the collapse about a third slower
+/// on the bunny for the same speed. Ties in the sort go by mesh index (deterministic). The
+/// halves are returned as leaves relative to `refs`' first record.
+fn split_leaf(refs: &mut [PrimRef]) -> [(ChildRef, Aabb); 2] {
+    let spread = refs
+        .iter()
+        .fold(Box3::EMPTY, |b, p| b.grow(p.centroid2()))
+        .extent();
+    let axis = spread.max_position();
+    refs.sort_unstable_by(|a, b| {
+        a.centroid2_on(axis)
+            .total_cmp(&b.centroid2_on(axis))
+            .then(a.id().cmp(&b.id()))
+    });
+    let packets = |k: usize| k.div_ceil(4) as f64;
+    let n = refs.len();
+    // The right-hand halves' costs, on the stack for the usual leaf sizes.
+    let (mut small, mut large) = ([0.0f64; 32], Vec::new());
+    let right: &mut [f64] = if n <= small.len() {
+        &mut small[..n]
+    } else {
+        large.resize(n, 0.0);
+        &mut large
+    };
+    let mut acc = Box3::EMPTY;
+    for k in (1..n).rev() {
+        acc = acc.union(&refs[k].bounds());
+        right[k] = acc.half_area() * packets(n - k);
+    }
+    let (mut best, mut k) = (f64::INFINITY, 1);
+    let mut acc = Box3::EMPTY;
+    for at in 1..n {
+        acc = acc.union(&refs[at - 1].bounds());
+        let cost = acc.half_area() * packets(at) + right[at];
+        if cost < best {
+            (best, k) = (cost, at);
+        }
+    }
+    let half = |range: &[PrimRef], index: usize| {
+        let b = range.iter().fold(Box3::EMPTY, |b, p| b.union(&p.bounds()));
+        let r = ChildRef {
+            index: index as u32,
+            count: range.len() as u32,
+        };
+        (r, b.to_aabb())
+    };
+    [half(&refs[..k], 0), half(&refs[k..], k)]
+}
+
+/// Collapses the binary subtree `r`, whose triangles are `refs` (the first of them record
+/// `start`), into wide nodes appended to `out` depth-first. Leaves stay triangle ranges
+/// (`{ index: first record, count }`) until [`number_packets`]. A subtree of
+/// [`PARALLEL_COLLAPSE`] triangles or more collapses its children on rayon, each into a
+/// vector of its own, appended in slot order afterwards: the same nodes in the same order as
+/// one thread makes them.
 fn collapse<const W: usize>(
-    binary: &[Node],
-    leaves: &mut Leaves,
+    b: &Binary,
+    refs: &mut [PrimRef],
+    start: u32,
     r: ChildRef,
     out: &mut Vec<WideNode<W>>,
-    leaf: &mut impl FnMut(ChildRef) -> ChildRef,
 ) -> ChildRef {
     if r.is_leaf() {
-        return leaf(r);
+        return r;
     }
-    let n = &binary[r.index as usize];
-    // A fixed array, not a Vec: one wide node per call, no allocation.
-    let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
-    kids[0] = (n.child[0], n.child_bounds(0));
-    kids[1] = (n.child[1], n.child_bounds(1));
-    let mut len = 2;
-    // The largest child (first on ties: deterministic) that `openable` accepts.
-    let largest = |kids: &[(ChildRef, Aabb)], openable: &dyn Fn(ChildRef) -> bool| {
-        (0..kids.len())
-            .filter(|&i| openable(kids[i].0))
-            .max_by(|&a, &b| {
-                kids[a]
-                    .1
-                    .surface_area()
-                    .total_cmp(&kids[b].1.surface_area())
-                    .then(b.cmp(&a))
-            })
-    };
-    while len < W {
-        // Open the interior child with the largest area, else split the largest leaf.
-        let two = if let Some(i) = largest(&kids[..len], &|c| !c.is_leaf()) {
-            let m = &binary[kids[i].0.index as usize];
-            (
-                i,
-                [
-                    (m.child[0], m.child_bounds(0)),
-                    (m.child[1], m.child_bounds(1)),
-                ],
-            )
-        } else if let Some(i) = largest(&kids[..len], &|c| {
-            leaves.fill_slots && c.is_leaf() && c.count > SPLIT_LEAVES_ABOVE
-        }) {
-            (i, leaves.split(kids[i].0))
-        } else {
-            break;
-        };
-        let (i, [a, b]) = two;
-        kids.copy_within(i + 1..len, i + 2);
-        kids[i] = a;
-        kids[i + 1] = b;
-        len += 1;
-    }
+    let parallel = refs.len() >= PARALLEL_COLLAPSE;
+    let (kids, len) = b.open::<W>(refs, start, r);
     let at = out.len();
     out.push(WideNode::empty());
-    for (slot, (child, bounds)) in kids[..len].iter().enumerate() {
-        let r = collapse(binary, leaves, *child, out, leaf);
-        out[at].set_child(slot, bounds, r);
+    // The children's triangles are consecutive ranges of `refs`, in slot order.
+    let mut jobs = Vec::with_capacity(len);
+    let (mut rest, mut first) = (refs, start);
+    for &(child, _) in &kids[..len] {
+        let size = b.size(child);
+        let (mine, tail) = std::mem::take(&mut rest).split_at_mut(size);
+        debug_assert!(!child.is_leaf() || child.index == first);
+        jobs.push((child, mine, first));
+        rest = tail;
+        first += size as u32;
+    }
+    if parallel {
+        use rayon::prelude::*;
+        let parts: Vec<(ChildRef, Vec<WideNode<W>>)> = jobs
+            .into_par_iter()
+            .map(|(child, mine, first)| {
+                let mut local = Vec::new();
+                let r = collapse(b, mine, first, child, &mut local);
+                (r, local)
+            })
+            .collect();
+        for (slot, (r, local)) in parts.into_iter().enumerate() {
+            let r = append_part(out, r, local);
+            out[at].set_child(slot, &kids[slot].1, r);
+        }
+    } else {
+        for (slot, (child, mine, first)) in jobs.into_iter().enumerate() {
+            let r = collapse(b, mine, first, child, out);
+            out[at].set_child(slot, &kids[slot].1, r);
+        }
     }
     ChildRef {
         index: at as u32,
@@ -363,9 +454,66 @@ fn collapse<const W: usize>(
     }
 }
 
+/// Appends a subtree collapsed into a vector of its own (interior references local to it) to
+/// `out`, and returns the reference to its root there.
+fn append_part<const W: usize>(
+    out: &mut Vec<WideNode<W>>,
+    r: ChildRef,
+    local: Vec<WideNode<W>>,
+) -> ChildRef {
+    if r.is_leaf() {
+        return r;
+    }
+    let base = out.len() as u32;
+    out.extend(local.into_iter().map(|mut node| {
+        let used = node.children();
+        for c in node.child[..used].iter_mut().filter(|c| !c.is_leaf()) {
+            c.index += base;
+        }
+        node
+    }));
+    ChildRef {
+        index: base + r.index,
+        count: 0,
+    }
+}
+
+/// Turns every leaf reference of the collapsed tree from a triangle range into its packets
+/// (`{ index: first packet, count: triangles }`), numbered in depth-first order, which is the
+/// order of the triangles; returns the triangle ranges in that order.
+fn number_packets<const W: usize>(nodes: &mut [WideNode<W>], r: &mut ChildRef) -> Vec<ChildRef> {
+    fn visit<const W: usize>(
+        nodes: &mut [WideNode<W>],
+        r: &mut ChildRef,
+        next: &mut u32,
+        ranges: &mut Vec<ChildRef>,
+    ) {
+        if r.is_leaf() {
+            ranges.push(*r);
+            r.index = *next;
+            *next += r.count.div_ceil(4);
+            return;
+        }
+        let i = r.index as usize;
+        for slot in 0..nodes[i].children() {
+            let mut c = nodes[i].child[slot];
+            visit(nodes, &mut c, next, ranges);
+            nodes[i].child[slot] = c;
+        }
+    }
+    let mut ranges = Vec::new();
+    visit(nodes, r, &mut 0, &mut ranges);
+    ranges
+}
+
 impl<const W: usize> BvhWide<W> {
     pub fn nodes(&self) -> &[WideNode<W>] {
         &self.nodes
+    }
+
+    /// The leaves' triangle packets, in depth-first order.
+    pub fn packets(&self) -> &[Tri4] {
+        &self.packets
     }
 
     /// The parts the closest-point walk reads (`point.rs`).
@@ -856,27 +1004,15 @@ impl<const W: usize> Accel for BvhWide<W> {
         }
         let mut flat = build::build(&mesh, &params.binary)?;
         let mut nodes = Vec::with_capacity(flat.nodes.len() / 3 + 1);
-        // The collapse only numbers the leaves' packets; they are filled afterwards, in
-        // parallel.
-        let mut leaves = Vec::new();
-        let mut next_packet = 0u32;
-        let root = if flat.refs.is_empty() {
-            ChildRef::default()
+        // The collapse leaves the leaves as triangle ranges; their packets are numbered
+        // afterwards and filled in parallel.
+        let (root, leaves) = if flat.refs.is_empty() {
+            (ChildRef::default(), Vec::new())
         } else {
-            let mut split = Leaves {
-                fill_slots: params.fill_slots,
-                refs: &mut flat.refs,
-                right: Vec::new(),
-            };
-            collapse(&flat.nodes, &mut split, flat.root, &mut nodes, &mut |r| {
-                leaves.push(r);
-                let index = next_packet;
-                next_packet += r.count.div_ceil(4);
-                ChildRef {
-                    index,
-                    count: r.count,
-                }
-            })
+            let binary = Binary::new(&flat.nodes, params.fill_slots);
+            let mut root = collapse(&binary, &mut flat.refs, 0, flat.root, &mut nodes);
+            let leaves = number_packets(&mut nodes, &mut root);
+            (root, leaves)
         };
         let packets = pack_leaves(&mesh, &flat.prim_ids(), &leaves);
         Ok(BvhWide {

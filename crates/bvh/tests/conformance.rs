@@ -171,6 +171,35 @@ fn filling_slots_splits_leaves_and_lowers_the_sah() {
     }
 }
 
+/// The wide trees do not depend on the thread count: the collapse runs its larger subtrees on
+/// rayon and appends each child's nodes in slot order, as one thread makes them.
+#[test]
+fn wide_trees_are_the_same_with_one_and_two_threads() {
+    fn check<const W: usize>(mesh: &std::sync::Arc<raybench_geom::TriangleMesh>) {
+        use raybench_accel::Accel;
+        let build = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a thread pool");
+            let params = WideParams::for_width(W as u32);
+            pool.install(|| BvhWide::<W>::build(mesh.clone(), &params).expect("builds"))
+        };
+        let (one, two) = (build(1), build(2));
+        assert!(
+            one.nodes().len() > 100,
+            "big enough to collapse in parallel"
+        );
+        assert!(one.nodes() == two.nodes(), "{W} wide: nodes differ");
+        assert!(one.packets() == two.packets(), "{W} wide: packets differ");
+    }
+    let mesh = raybench_scenes::generate("teapot:triangles=20000", 1)
+        .expect("generates")
+        .mesh;
+    check::<8>(&mesh);
+    check::<4>(&mesh);
+}
+
 /// The SSE kernels (what a CPU without AVX2 runs) answer like the AVX2 ones, at width `W`:
 /// the same suite, and the same hits and counters ray for ray on a seeded scene, with leaves
 /// small enough for one packet and large enough for several (the AVX2 leaf test takes two
