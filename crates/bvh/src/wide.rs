@@ -202,32 +202,28 @@ pub type Bvh8 = BvhWide<8>;
 /// 4 children per node, tested in one SSE pass per axis: half the node bytes, twice the depth.
 pub type Bvh4 = BvhWide<4>;
 
-/// Appends the packets of one binary leaf (mesh triangles `ids`) and returns its wide reference.
-fn pack_leaf(mesh: &TriangleMesh, ids: &[u32]) -> impl Iterator<Item = Tri4> {
-    ids.chunks(4).map(|chunk| {
+/// The packets of one leaf (the builder's records `refs`), four triangles to a packet.
+fn pack_leaf<'a>(mesh: &'a TriangleMesh, refs: &'a [PrimRef]) -> impl Iterator<Item = Tri4> + 'a {
+    refs.chunks(4).map(|chunk| {
         let mut packet = Tri4::default();
-        for (lane, &i) in chunk.iter().enumerate() {
+        for (lane, p) in chunk.iter().enumerate() {
+            let i = p.id();
             packet.set_lane(lane, i, &MollerTriangle::new(&mesh.triangle(i as usize)));
         }
         packet
     })
 }
 
-/// The packets of every binary leaf in `leaves` (depth-first order), built on rayon: gathering
-/// each triangle's vertices from the mesh is the part of the collapse that touches memory at
-/// random, and leaves are independent. `collect` keeps their order, so the result does not
-/// depend on the thread count.
-fn pack_leaves(mesh: &TriangleMesh, prim_ids: &[u32], leaves: &[ChildRef]) -> Vec<Tri4> {
+/// The packets of every leaf in `leaves` (triangle ranges of `refs`, depth-first order),
+/// built on rayon: gathering each triangle's vertices from the mesh is the part of the
+/// collapse that touches memory at random, and leaves are independent. `collect` keeps their
+/// order, so the result does not depend on the thread count.
+fn pack_leaves(mesh: &TriangleMesh, refs: &[PrimRef], leaves: &[ChildRef]) -> Vec<Tri4> {
     use rayon::prelude::*;
     leaves
         .par_iter()
         .with_min_len(256)
-        .flat_map_iter(|r| {
-            pack_leaf(
-                mesh,
-                &prim_ids[r.index as usize..(r.index + r.count) as usize],
-            )
-        })
+        .flat_map_iter(|r| pack_leaf(mesh, &refs[r.index as usize..(r.index + r.count) as usize]))
         .collect()
 }
 
@@ -319,19 +315,8 @@ impl Binary<'_> {
             }) {
                 let leaf = kids[i].0;
                 let at = (leaf.index - start) as usize;
-                let halves = split_leaf(&mut refs[at..at + leaf.count as usize]);
-                (
-                    i,
-                    halves.map(|(k, b)| {
-                        (
-                            ChildRef {
-                                index: leaf.index + k.index,
-                                ..k
-                            },
-                            b,
-                        )
-                    }),
-                )
+                let range = &mut refs[at..at + leaf.count as usize];
+                (i, split_leaf(range, leaf.index))
             } else {
                 break;
             };
@@ -345,13 +330,13 @@ impl Binary<'_> {
     }
 }
 
-/// Splits a leaf's triangles `refs` in two, forced (as Embree's wide builder splits every
-/// child of more than one block until the node is full): sorted by centroid on the axis where
-/// the centroids spread most, cut where `area × packets` summed over both halves is least
-/// (first on ties). One axis, not three: three sorts made the collapse about a third slower
-/// on the bunny for the same speed. Ties in the sort go by mesh index (deterministic). The
-/// halves are returned as leaves relative to `refs`' first record.
-fn split_leaf(refs: &mut [PrimRef]) -> [(ChildRef, Aabb); 2] {
+/// Splits a leaf's triangles `refs` (the first of them record `first`) in two, forced (as
+/// Embree's wide builder splits every child of more than one block until the node is full):
+/// sorted by centroid on the axis where the centroids spread most, cut where `area × packets`
+/// summed over both halves is least (first on ties). One axis, not three: three sorts made the
+/// collapse about a third slower on the bunny for the same speed. Ties in the sort go by mesh
+/// index (deterministic).
+fn split_leaf(refs: &mut [PrimRef], first: u32) -> [(ChildRef, Aabb); 2] {
     let spread = refs
         .iter()
         .fold(Box3::EMPTY, |b, p| b.grow(p.centroid2()))
@@ -364,37 +349,36 @@ fn split_leaf(refs: &mut [PrimRef]) -> [(ChildRef, Aabb); 2] {
     });
     let packets = |k: usize| k.div_ceil(4) as f64;
     let n = refs.len();
-    // The right-hand halves' costs, on the stack for the usual leaf sizes.
-    let (mut small, mut large) = ([0.0f64; 32], Vec::new());
-    let right: &mut [f64] = if n <= small.len() {
+    // The boxes of the right-hand halves `refs[k..]`, on the stack for the usual leaf sizes.
+    let (mut small, mut large) = ([Box3::EMPTY; 32], Vec::new());
+    let right: &mut [Box3] = if n <= small.len() {
         &mut small[..n]
     } else {
-        large.resize(n, 0.0);
+        large.resize(n, Box3::EMPTY);
         &mut large
     };
     let mut acc = Box3::EMPTY;
     for k in (1..n).rev() {
         acc = acc.union(&refs[k].bounds());
-        right[k] = acc.half_area() * packets(n - k);
+        right[k] = acc;
     }
-    let (mut best, mut k) = (f64::INFINITY, 1);
+    let (mut best, mut cut, mut left) = (f64::INFINITY, 1, Box3::EMPTY);
     let mut acc = Box3::EMPTY;
-    for at in 1..n {
-        acc = acc.union(&refs[at - 1].bounds());
-        let cost = acc.half_area() * packets(at) + right[at];
+    for k in 1..n {
+        acc = acc.union(&refs[k - 1].bounds());
+        let cost = acc.half_area() * packets(k) + right[k].half_area() * packets(n - k);
         if cost < best {
-            (best, k) = (cost, at);
+            (best, cut, left) = (cost, k, acc);
         }
     }
-    let half = |range: &[PrimRef], index: usize| {
-        let b = range.iter().fold(Box3::EMPTY, |b, p| b.union(&p.bounds()));
+    let leaf = |index: usize, count: usize, b: Box3| {
         let r = ChildRef {
-            index: index as u32,
-            count: range.len() as u32,
+            index: first + index as u32,
+            count: count as u32,
         };
         (r, b.to_aabb())
     };
-    [half(&refs[..k], 0), half(&refs[k..], k)]
+    [leaf(0, cut, left), leaf(cut, n - cut, right[cut])]
 }
 
 /// Collapses the binary subtree `r`, whose triangles are `refs` (the first of them record
@@ -1014,7 +998,7 @@ impl<const W: usize> Accel for BvhWide<W> {
             let leaves = number_packets(&mut nodes, &mut root);
             (root, leaves)
         };
-        let packets = pack_leaves(&mesh, &flat.prim_ids(), &leaves);
+        let packets = pack_leaves(&mesh, &flat.refs, &leaves);
         Ok(BvhWide {
             params: params.clone(),
             nodes,

@@ -131,6 +131,11 @@ fn both_widths_share_the_leaves_and_differ_in_depth() {
         children(&s4) <= 4.0 && children(&s8) > children(&s4),
         "{s4:?} {s8:?}"
     );
+    // The default trees fill their slots: more than four children per 8-wide node.
+    let f4 = Bvh4::build(mesh.clone(), &WideParams::for_width(4)).expect("builds");
+    let f8 = Bvh8::build(mesh.clone(), &WideParams::for_width(8)).expect("builds");
+    let (f4, f8) = (f4.build_stats(), f8.build_stats());
+    assert!(children(&f4) <= 4.0 && children(&f8) > 4.0, "{f4:?} {f8:?}");
 }
 
 /// Filling a node's empty slots by splitting leaves keeps the interior nodes and every
