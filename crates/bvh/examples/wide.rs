@@ -6,7 +6,13 @@
 //!
 //! `cargo run --release -p raybench-bvh --example wide -- ../shared/scenes/stanford-bunny.obj 50000 20`
 //! (scene: an .obj path or a generator spec such as `hair`; rays per workload; rounds;
-//! optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round.
+//! optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round
+//! (valgrind runs no AVX-512, so there `bvh8` takes the AVX2-only loops).
+//!
+//! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
+//! CPU without AVX-512 the two are the same code. `RB_ONLY=embree-medium,bvh8` keeps only the
+//! structures named, for profiling one structure alone; ratios are then to the first one kept
+//! (embree-medium whenever it is kept).
 
 use raybench_accel::{Accel, PreparedRays};
 use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, NodeSimd, WideParams};
@@ -74,10 +80,24 @@ fn main() {
         node_simd: NodeSimd::Sse,
         ..Bvh8Params::default()
     };
+    let only_avx2 = Bvh8Params {
+        node_simd: NodeSimd::Avx2,
+        ..Bvh8Params::default()
+    };
+    add("bvh8-avx2", &|| {
+        Box::new(Bvh8::build(Arc::clone(&mesh), &only_avx2).expect("builds"))
+    });
     add("bvh8-sse", &|| {
         Box::new(Bvh8::build(Arc::clone(&mesh), &sse).expect("builds"))
     });
 
+    if let Ok(keep) = std::env::var("RB_ONLY") {
+        structures.retain(|(n, _, _)| keep.split(',').any(|k| k == n));
+        if structures.is_empty() {
+            eprintln!("RB_ONLY={keep}: no structure of this example has that name");
+            std::process::exit(2);
+        }
+    }
     let primary = raybench_scenes::primary_rays(&scene.view, &bounds, n).0;
     let reference = &structures[0].1;
     let hits: Vec<Option<SurfaceHit>> = primary

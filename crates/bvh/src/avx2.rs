@@ -6,8 +6,15 @@
 //! when a lane is NaN (`0 * inf` for a ray in a box's face plane, bug class B1), the compare is
 //! ordered (false on NaN). [`Avx2Nodes`] can only be made by [`Avx2Nodes::detect`], after the
 //! CPU has reported AVX2, which is what makes calling the `#[target_feature]` code sound.
-//! AVX-512 adds nothing for 8 lanes of f32 that AVX2 lacks here (the mask compare into `k`
-//! registers saves one `movemask`), so it is not a separate kernel.
+//! AVX-512 adds no arithmetic an 8-lane f32 test needs, so there is no AVX-512 kernel. What it
+//! adds is registers: 32 vector registers instead of 16. The walk keeps ten splatted values of
+//! the ray live (origin, direction, inverse direction, `t_min`); with AVX2's sixteen, the
+//! compiler spilled them and reloaded six at every node. The batch loops are therefore
+//! compiled twice ([`batch_loops`]), once with AVX-512F and VL enabled; the same arithmetic
+//! runs in both, so the answers and counters are the same. Over the 17 scenes of the default
+//! suite, best of 10 passes interleaved with embree-medium in one process (`examples/wide.rs`,
+//! this VM's Zen 4, 2026-11-21), the AVX-512 loops against the AVX2 ones, three sweeps:
+//! primary +7.4 / +7.1 / +7.0 %, random +5.2 / +3.7 / +4.2 %, shadow +5.8 / +6.8 / +2.3 %.
 //!
 //! Leaves get the same treatment: two [`Tri4`] packets in one 8-lane Möller–Trumbore pass
 //! ([`leaf_pairs`]), the same operations lane for lane as the SSE packet test and the same
@@ -22,13 +29,26 @@ use raybench_accel::{CounterSink, Hit, NoCount};
 use raybench_geom::{Ray, TriHit};
 use std::arch::x86_64::*;
 
-/// Proof that this CPU runs AVX2: the only way to reach the AVX2 code.
+/// Proof that this CPU runs AVX2 (the only way to reach the AVX2 code), and whether the batch
+/// loops may also use AVX-512VL's 32 vector registers.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Avx2Nodes(());
+pub(crate) struct Avx2Nodes {
+    wide_registers: bool,
+}
 
 impl Avx2Nodes {
-    pub(crate) fn detect() -> Option<Avx2Nodes> {
-        std::arch::is_x86_feature_detected!("avx2").then_some(Avx2Nodes(()))
+    /// AVX2 when the CPU has it; with `avx512` also AVX-512F and VL when it has them.
+    pub(crate) fn detect(avx512: bool) -> Option<Avx2Nodes> {
+        std::arch::is_x86_feature_detected!("avx2").then(|| Avx2Nodes {
+            wide_registers: avx512
+                && std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx512vl"),
+        })
+    }
+
+    /// Whether the batch loops run with AVX-512VL's registers.
+    pub(crate) fn wide_registers(self) -> bool {
+        self.wide_registers
     }
 }
 
@@ -326,36 +346,49 @@ pub(crate) fn walk_ray<const W: usize, const ANY_HIT: bool, C: CounterSink>(
     unsafe { walk_ray_avx2::<W, ANY_HIT, C>(bvh, k, ray, stack, c) }
 }
 
-/// Closest hits of a batch of rays in one AVX2 function: the loop lives inside the
-/// `#[target_feature]` code, so a ray pays no call, prologue or kernel dispatch of its own.
-#[target_feature(enable = "avx2")]
-fn intersect_all_avx2<const W: usize>(
-    bvh: &BvhWide<W>,
-    k: Avx2Nodes,
-    rays: &[Ray],
-    out: &mut [Option<Hit>],
-    stack: &mut Stack,
-) {
-    for (o, ray) in out.iter_mut().zip(rays) {
-        *o = bvh.walk_ray::<false, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount);
-    }
+/// The batch loops, once per instruction set: the loop lives inside the `#[target_feature]`
+/// code, so a ray pays no call, prologue or kernel dispatch of its own. The AVX-512 copies run
+/// the same AVX2 arithmetic lane for lane (so the same answers); what they gain is sixteen more
+/// vector registers, so the splatted ray (origin, direction, inverse direction, `t_min`: ten
+/// registers) no longer spills to the stack and is reloaded at every node.
+macro_rules! batch_loops {
+    ($features:literal, $closest:ident, $any:ident) => {
+        #[target_feature(enable = $features)]
+        fn $closest<const W: usize>(
+            bvh: &BvhWide<W>,
+            k: Avx2Nodes,
+            rays: &[Ray],
+            out: &mut [Option<Hit>],
+            stack: &mut Stack,
+        ) {
+            for (o, ray) in out.iter_mut().zip(rays) {
+                *o = bvh.walk_ray::<false, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount);
+            }
+        }
+
+        #[target_feature(enable = $features)]
+        fn $any<const W: usize>(
+            bvh: &BvhWide<W>,
+            k: Avx2Nodes,
+            rays: &[Ray],
+            out: &mut [bool],
+            stack: &mut Stack,
+        ) {
+            for (o, ray) in out.iter_mut().zip(rays) {
+                *o = bvh
+                    .walk_ray::<true, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount)
+                    .is_some();
+            }
+        }
+    };
 }
 
-/// Any-hit answers of a batch of rays, as [`intersect_all_avx2`].
-#[target_feature(enable = "avx2")]
-fn occluded_all_avx2<const W: usize>(
-    bvh: &BvhWide<W>,
-    k: Avx2Nodes,
-    rays: &[Ray],
-    out: &mut [bool],
-    stack: &mut Stack,
-) {
-    for (o, ray) in out.iter_mut().zip(rays) {
-        *o = bvh
-            .walk_ray::<true, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount)
-            .is_some();
-    }
-}
+batch_loops!("avx2", intersect_all_avx2, occluded_all_avx2);
+batch_loops!(
+    "avx2,avx512f,avx512vl",
+    intersect_all_avx512,
+    occluded_all_avx512
+);
 
 pub(crate) fn intersect_all<const W: usize>(
     bvh: &BvhWide<W>,
@@ -364,8 +397,13 @@ pub(crate) fn intersect_all<const W: usize>(
     out: &mut [Option<Hit>],
     stack: &mut Stack,
 ) {
-    // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
-    unsafe { intersect_all_avx2(bvh, k, rays, out, stack) }
+    if k.wide_registers {
+        // SAFETY: `k` says AVX-512F and VL only when `detect` saw them on this CPU.
+        unsafe { intersect_all_avx512(bvh, k, rays, out, stack) }
+    } else {
+        // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
+        unsafe { intersect_all_avx2(bvh, k, rays, out, stack) }
+    }
 }
 
 pub(crate) fn occluded_all<const W: usize>(
@@ -375,8 +413,13 @@ pub(crate) fn occluded_all<const W: usize>(
     out: &mut [bool],
     stack: &mut Stack,
 ) {
-    // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
-    unsafe { occluded_all_avx2(bvh, k, rays, out, stack) }
+    if k.wide_registers {
+        // SAFETY: `k` says AVX-512F and VL only when `detect` saw them on this CPU.
+        unsafe { occluded_all_avx512(bvh, k, rays, out, stack) }
+    } else {
+        // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
+        unsafe { occluded_all_avx2(bvh, k, rays, out, stack) }
+    }
 }
 
 #[cfg(test)]
@@ -400,7 +443,7 @@ mod tests {
     /// hit, with a best distance carried in from earlier leaves.
     #[test]
     fn pairs_answer_as_the_packet_loop() {
-        let Some(_) = Avx2Nodes::detect() else {
+        let Some(_) = Avx2Nodes::detect(false) else {
             eprintln!("no AVX2 on this CPU: the pair test has nothing to check");
             return;
         };
@@ -479,7 +522,7 @@ mod tests {
 
     #[test]
     fn a_lone_packet_leaves_the_upper_lanes_empty() {
-        let Some(_) = Avx2Nodes::detect() else {
+        let Some(_) = Avx2Nodes::detect(false) else {
             return;
         };
         let tri = MollerTriangle::new(&Triangle::new(Vec3::X, Vec3::Y, Vec3::Z));

@@ -110,9 +110,13 @@ pub(crate) fn quad<const W: usize>(row: &[f32; W], q: usize) -> &[f32; 4] {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum NodeSimd {
-    /// AVX2 when the CPU has it (run-time detection), SSE otherwise.
+    /// AVX2 when the CPU has it (run-time detection), SSE otherwise; the batch loops with
+    /// AVX-512VL's 32 registers when the CPU has AVX-512F and VL too.
     #[default]
     Auto,
+    /// AVX2 when the CPU has it, never AVX-512 (the kernels as they were before `Auto` used
+    /// AVX-512's registers, for comparison).
+    Avx2,
     /// 4-lane SSE: one pass per axis and four children, one packet of four triangles a pass
     /// (the x86-64 baseline; portable code elsewhere).
     Sse,
@@ -525,6 +529,14 @@ impl<const W: usize> BvhWide<W> {
     pub fn uses_avx2(&self) -> bool {
         #[cfg(target_arch = "x86_64")]
         return self.avx2.is_some();
+        #[cfg(not(target_arch = "x86_64"))]
+        false
+    }
+
+    /// Whether the batch loops run with AVX-512VL's 32 vector registers (same arithmetic).
+    pub fn avx512_registers(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return self.avx2.is_some_and(|k| k.wide_registers());
         #[cfg(not(target_arch = "x86_64"))]
         false
     }
@@ -1008,7 +1020,8 @@ impl<const W: usize> Accel for BvhWide<W> {
             mesh,
             #[cfg(target_arch = "x86_64")]
             avx2: match params.node_simd {
-                NodeSimd::Auto => crate::avx2::Avx2Nodes::detect(),
+                NodeSimd::Auto => crate::avx2::Avx2Nodes::detect(true),
+                NodeSimd::Avx2 => crate::avx2::Avx2Nodes::detect(false),
                 NodeSimd::Sse => None,
             },
         })
@@ -1143,6 +1156,10 @@ impl<const W: usize> BvhWide<W> {
         );
         s.extra
             .insert("avx2_kernels".into(), self.uses_avx2() as u8 as f64);
+        s.extra.insert(
+            "avx512_registers".into(),
+            self.avx512_registers() as u8 as f64,
+        );
         s.nodes += s.leaves;
         s.sah_cost = (root_area > 0.0).then_some(sah);
         s

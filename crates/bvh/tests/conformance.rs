@@ -240,6 +240,45 @@ fn sse_matches_avx2_at<const W: usize>() {
     }
 }
 
+/// The batch loops exist twice on x86-64: with AVX-512's registers (what `Auto` runs on a CPU
+/// with AVX-512F and VL) and AVX2 only (what `Avx2` always runs, and `Auto` without AVX-512).
+/// The suite compares the batch path with the single-ray path ray for ray; here it runs on the
+/// AVX2-only loops too, so a machine with AVX-512 tests both.
+fn avx2_only_conforms_at<const W: usize>() {
+    use raybench_accel::Accel;
+    let auto = BvhWide::<W>::build(
+        raybench_scenes::generate("sphere:triangles=200", 1)
+            .expect("generates")
+            .mesh,
+        &WideParams::for_width(W as u32),
+    )
+    .expect("builds");
+    #[cfg(target_arch = "x86_64")]
+    assert_eq!(
+        auto.avx512_registers(),
+        std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl"),
+        "Auto uses AVX-512's registers exactly when the CPU has them"
+    );
+    let avx2 = WideParams {
+        node_simd: raybench_bvh::NodeSimd::Avx2,
+        ..WideParams::for_width(W as u32)
+    };
+    let counts = conformance::<BvhWide<W>>(&avx2, &|b, mesh| {
+        if b.avx512_registers() {
+            return Err("NodeSimd::Avx2 ran with AVX-512".into());
+        }
+        b.validate(mesh)
+    });
+    assert_eq!(counts.mismatch, 0);
+}
+
+#[test]
+fn wide_avx2_only_kernel_conforms() {
+    avx2_only_conforms_at::<8>();
+    avx2_only_conforms_at::<4>();
+}
+
 #[test]
 fn wide_sse_kernel_conforms_and_matches_the_default() {
     sse_matches_avx2_at::<8>();
