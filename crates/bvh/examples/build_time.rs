@@ -15,7 +15,8 @@
 //! that a builder change keeps them identical, and with any thread count.
 //!
 //! `cargo run --release -p raybench-bvh --example build_time -- ../shared/scenes/stanford-bunny.obj 2 21`
-//! (scene, threads, rounds, optionally a label filter). Under `valgrind --tool=callgrind` use 1 round.
+//! (scene: an .obj path or a generator spec such as `city`; threads; rounds; optionally a label
+//! filter). Under `valgrind --tool=callgrind` use 1 round.
 
 use raybench_accel::Accel;
 use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
@@ -62,7 +63,12 @@ fn main() {
     // Only the structures whose label contains this (embree-medium is always built, as the
     // base of the ratios), to profile one build alone.
     let only = args.next();
-    let scene = raybench_scenes::load_obj(std::path::Path::new(&path)).expect("scene loads");
+    // An .obj path, or a generator spec as the harness takes them (`hair`, `soup:triangles=5000`).
+    let scene = if path.ends_with(".obj") {
+        raybench_scenes::load_obj(std::path::Path::new(&path)).expect("scene loads")
+    } else {
+        raybench_scenes::generate(&path, 1).expect("scene generates")
+    };
     let mesh = Arc::clone(&scene.mesh);
 
     let pool = rayon::ThreadPoolBuilder::new()

@@ -163,19 +163,47 @@ impl Binner {
         F4::from_vec3a(f).trunc_i32()
     }
 
-    /// Adds `refs` to the first `self.bins` bins of `bins`.
-    fn fill(&self, refs: &[PrimRef], bins: &mut Bins) {
-        for p in refs {
-            let b = p.bounds();
-            let slots = self.bins_of(p.centroid2());
-            for (axis, &slot) in slots[..3].iter().enumerate() {
-                let slot = slot as usize;
-                bins.boxes[slot][axis] = bins.boxes[slot][axis].union(&b);
-                bins.counts[slot][axis] += 1;
-            }
+    /// Adds one record to the first `self.bins` bins of `bins`.
+    #[inline(always)]
+    fn add(&self, p: &PrimRef, bins: &mut Bins) {
+        let b = p.bounds();
+        let slots = self.bins_of(p.centroid2());
+        for (axis, &slot) in slots[..3].iter().enumerate() {
+            // `bins_of` keeps the slot below `self.bins`, so the mask changes nothing; it
+            // lets the compiler drop the bounds check.
+            let slot = slot as usize & (MAX_BINS - 1);
+            bins.boxes[slot][axis] = bins.boxes[slot][axis].union(&b);
+            bins.counts[slot][axis] += 1;
         }
     }
+
+    /// Adds `refs` to the first `self.bins` bins of `bins`. Above [`PAIRED_FILL`] records,
+    /// every other record goes to `spare` (reset here), merged in at the end: in a mesh
+    /// stored in spatial order, consecutive records mostly land in the same bins, and each
+    /// update of a bin then waited for the previous one's store. Min, max and counts give the
+    /// same bins in any order.
+    fn fill(&self, refs: &[PrimRef], bins: &mut Bins, spare: &mut Bins) {
+        if refs.len() < PAIRED_FILL {
+            for p in refs {
+                self.add(p, bins);
+            }
+            return;
+        }
+        spare.reset(self.bins);
+        let (pairs, rest) = refs.as_chunks::<2>();
+        for [a, b] in pairs {
+            self.add(a, bins);
+            self.add(b, spare);
+        }
+        for p in rest {
+            self.add(p, bins);
+        }
+        bins.merge(spare, self.bins);
+    }
 }
+
+/// Records from which [`Binner::fill`] splits its updates over two sets of bins.
+const PAIRED_FILL: usize = 256;
 
 /// Per bin and axis: the box of the triangles whose centroid falls in it, and their number.
 /// 7 KiB at [`MAX_BINS`], so there is one per sequential task (in its [`Scratch`]), and a node
@@ -213,6 +241,8 @@ impl Bins {
 /// Working memory of the binned builder, reused by every node a sequential task builds.
 pub(crate) struct Scratch {
     bins: Bins,
+    /// The second set of bins of [`Binner::fill`].
+    spare: Bins,
     sweep: Sweep,
 }
 
@@ -230,6 +260,7 @@ impl Scratch {
     pub(crate) fn new() -> Box<Scratch> {
         Box::new(Scratch {
             bins: Bins::EMPTY,
+            spare: Bins::EMPTY,
             sweep: Sweep {
                 right: [([0.0; 3], [0; 3]); MAX_BINS],
                 left_count: [[0; 3]; MAX_BINS],
@@ -266,7 +297,7 @@ pub(crate) fn binned_split(
     let bins = if n >= PARALLEL_BINNING {
         let fill = |c: &[PrimRef]| {
             let mut bins = Box::new(Bins::EMPTY);
-            binner.fill(c, &mut bins);
+            binner.fill(c, &mut bins, &mut Box::new(Bins::EMPTY));
             bins
         };
         parallel = refs.par_chunks(8192).map(fill).reduce(
@@ -279,7 +310,7 @@ pub(crate) fn binned_split(
         &*parallel
     } else {
         scratch.bins.reset(nb);
-        binner.fill(refs, &mut scratch.bins);
+        binner.fill(refs, &mut scratch.bins, &mut scratch.spare);
         &scratch.bins
     };
     let sweep = &mut scratch.sweep;
