@@ -202,7 +202,9 @@ impl Binner {
     }
 }
 
-/// Records from which [`Binner::fill`] splits its updates over two sets of bins.
+/// Records from which [`Binner::fill`] splits its updates over two sets of bins. Not tuned:
+/// smaller nodes have few bins to reset and merge, and are too short for the chains of stores
+/// to matter.
 const PAIRED_FILL: usize = 256;
 
 /// Per bin and axis: the box of the triangles whose centroid falls in it, and their number.
