@@ -64,11 +64,7 @@ fn main() {
     // base of the ratios), to profile one build alone.
     let only = args.next();
     // An .obj path, or a generator spec as the harness takes them (`hair`, `soup:triangles=5000`).
-    let scene = if path.ends_with(".obj") {
-        raybench_scenes::load_obj(std::path::Path::new(&path)).expect("scene loads")
-    } else {
-        raybench_scenes::generate(&path, 1).expect("scene generates")
-    };
+    let scene = raybench_scenes::resolve(&path, 1).expect("scene loads");
     let mesh = Arc::clone(&scene.mesh);
 
     let pool = rayon::ThreadPoolBuilder::new()

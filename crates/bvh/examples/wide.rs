@@ -50,11 +50,7 @@ fn main() {
     let rounds: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);
     let only = args.next(); // one workload's name, to profile it alone
     // An .obj path, or a generator spec as the harness takes them (`hair`, `soup:triangles=5000`).
-    let scene = if path.ends_with(".obj") {
-        raybench_scenes::load_obj(std::path::Path::new(&path)).expect("scene loads")
-    } else {
-        raybench_scenes::generate(&path, 1).expect("scene generates")
-    };
+    let scene = raybench_scenes::resolve(&path, 1).expect("scene loads");
     let mesh = Arc::clone(&scene.mesh);
     let bounds = mesh.bounds();
 
