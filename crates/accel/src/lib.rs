@@ -168,6 +168,14 @@ pub trait Accel: Send + Sync {
         Ok(PreparedRays::Native)
     }
 
+    /// [`Accel::prepare_rays`] for a batch whose consecutive rays are coherent (camera rays in
+    /// scanline order, as the `primary` workload makes them): a structure may then trace them
+    /// in packets. Embree has the same hint (`RTC_INTERSECT_CONTEXT_FLAG_COHERENT`). The
+    /// default ignores it.
+    fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, raybench_geom::RayError> {
+        self.prepare_rays(rays)
+    }
+
     /// Traces `rays[first..first + out.len()]` (closest hit): the timed batch path.
     fn intersect_prepared(
         &self,

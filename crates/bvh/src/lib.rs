@@ -18,6 +18,8 @@
 mod avx2;
 pub mod build;
 mod node;
+#[cfg(target_arch = "x86_64")]
+mod packet;
 mod point;
 mod simd;
 mod traverse;

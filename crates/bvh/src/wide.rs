@@ -38,7 +38,7 @@ use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, NoCount, PreparedRays,
     SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST,
 };
-use raybench_geom::{Aabb, MollerTriangle, Ray, TriHit, TriangleMesh, Vec3};
+use raybench_geom::{Aabb, MollerTriangle, Ray, RayError, TriHit, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -48,7 +48,7 @@ pub const MAX_WIDTH: usize = 8;
 
 /// Stack entries a walk can need: a node pushes at most `MAX_WIDTH - 1`, one per level, and
 /// the binary builder caps the depth at [`MAX_DEPTH`] (collapsing only shortens it).
-const STACK: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
+pub(crate) const STACK: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
 
 /// One wide node of `W` children (4 or 8): child boxes per axis as `[min or max][slot]`, so
 /// one SIMD load fetches a plane of four or eight children; unused slots hold an empty box
@@ -135,6 +135,11 @@ pub struct WideParams {
     /// Split leaves of more than one packet into the slots a node would leave empty (see
     /// [`collapse`]); off, the wide tree has exactly the binary tree's leaves.
     pub fill_slots: bool,
+    /// Batches prepared as coherent (`Accel::prepare_coherent_rays`: the primary rays) are
+    /// traced for closest hit sixteen rays at a time, one per AVX-512 lane ([`crate::packet`]),
+    /// when the CPU has AVX-512F; every other batch, and every batch without AVX-512, ray by
+    /// ray. The registry's `bvh8-packets`.
+    pub coherent_packets: bool,
 }
 
 /// The 8-wide tree's knobs (the name the reports and tests have used since issue 8 began).
@@ -181,6 +186,7 @@ impl Default for WideParams {
             width: MAX_WIDTH as u32,
             node_simd: NodeSimd::Auto,
             fill_slots: true,
+            coherent_packets: false,
         }
     }
 }
@@ -199,6 +205,9 @@ pub struct BvhWide<const W: usize> {
     mesh: Arc<TriangleMesh>,
     #[cfg(target_arch = "x86_64")]
     avx2: Option<crate::avx2::Avx2Nodes>,
+    /// The packet walk for coherent batches, when asked for and the CPU has AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    coherent: Option<crate::packet::Avx512Packets>,
 }
 
 /// 8 children per node, tested in one AVX2 pass per axis: the structure that races Embree.
@@ -514,6 +523,10 @@ impl<const W: usize> BvhWide<W> {
     }
 
     /// The leaves' triangle packets, in depth-first order.
+    pub(crate) fn root(&self) -> ChildRef {
+        self.root
+    }
+
     pub fn packets(&self) -> &[Tri4] {
         &self.packets
     }
@@ -543,6 +556,15 @@ impl<const W: usize> BvhWide<W> {
     pub fn uses_avx2(&self) -> bool {
         #[cfg(target_arch = "x86_64")]
         return self.avx2.is_some();
+        #[cfg(not(target_arch = "x86_64"))]
+        false
+    }
+
+    /// Whether coherent batches are traced in packets (`coherent_packets` asked for it and the
+    /// CPU has AVX-512F).
+    pub fn packet_walk(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return self.coherent.is_some();
         #[cfg(not(target_arch = "x86_64"))]
         false
     }
@@ -1038,13 +1060,20 @@ impl<const W: usize> Accel for BvhWide<W> {
                 NodeSimd::Avx2 => crate::avx2::Avx2Nodes::detect(false),
                 NodeSimd::Sse => None,
             },
+            #[cfg(target_arch = "x86_64")]
+            coherent: params
+                .coherent_packets
+                .then(crate::packet::Avx512Packets::detect)
+                .flatten(),
         })
     }
 
     fn name(&self) -> &str {
-        match W {
-            4 => "bvh4-binned",
-            _ => "bvh8-binned",
+        match (W, self.params.coherent_packets) {
+            (4, false) => "bvh4-binned",
+            (4, true) => "bvh4-packets",
+            (_, false) => "bvh8-binned",
+            (_, true) => "bvh8-packets",
         }
     }
 
@@ -1077,13 +1106,32 @@ impl<const W: usize> Accel for BvhWide<W> {
         crate::point::closest_point_wide(&self.point_view(), p, max_radius, c)
     }
 
+    /// With the packet walk, the rays are laid out in packets of sixteen, structure of arrays
+    /// (as Embree's stream takes `RTCRayHit`s, converted outside timing); without it, as they
+    /// are.
+    fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
+        #[cfg(target_arch = "x86_64")]
+        if self.coherent.is_some() {
+            let packets = crate::packet::RayPackets::new(rays);
+            return Ok(PreparedRays::Foreign(Box::new(packets)));
+        }
+        Ok(PreparedRays::Native)
+    }
+
     fn intersect_prepared(
         &self,
         rays: &[Ray],
-        _: &PreparedRays,
+        prepared: &PreparedRays,
         first: usize,
         out: &mut [Option<Hit>],
     ) {
+        #[cfg(target_arch = "x86_64")]
+        if let (Some(k), PreparedRays::Foreign(any)) = (self.coherent, prepared)
+            && let Some(packets) = any.downcast_ref::<crate::packet::RayPackets>()
+            && let Some(packets) = packets.range(first, out.len())
+        {
+            return crate::packet::intersect_coherent(k, self, packets, out);
+        }
         let mut stack = new_stack();
         let rays = &rays[first..];
         #[cfg(target_arch = "x86_64")]

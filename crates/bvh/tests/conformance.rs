@@ -395,3 +395,134 @@ fn too_large_is_an_error_not_an_abort() {
     // The default limit builds it.
     assert!(Bvh::build(mesh, &BvhParams::binned()).is_ok());
 }
+
+// ---- The packet walk of coherent batches --------------------------------------------------
+
+/// The packet walk (`coherent_packets`) under the shared suite (whose coherent-batch check
+/// holds it to brute force), and on every case's rays bit-identical to the single-ray walk but
+/// for ties: each lane computes its ray's single-ray arithmetic, and walks only the boxes its
+/// ray entered. Without AVX-512F the batches are walked ray by ray and both checks still hold.
+#[test]
+fn packet_walk_conforms() {
+    use raybench_accel::Accel;
+    fn at<const W: usize>() {
+        for params in wide_params(W as u32) {
+            let params = WideParams {
+                coherent_packets: true,
+                ..params
+            };
+            let counts = conformance::<BvhWide<W>>(&params, &|b, mesh| b.validate(mesh));
+            assert_eq!(counts.mismatch, 0, "{params:?}");
+            for case in raybench_testkit::seeded_cases()
+                .into_iter()
+                .chain(raybench_testkit::edge_cases())
+            {
+                let bvh = BvhWide::<W>::build(case.mesh.clone(), &params).expect("builds");
+                let rays: Vec<_> = case
+                    .rays
+                    .iter()
+                    .copied()
+                    .filter(|r| r.check().is_ok())
+                    .collect();
+                // Ties are common here (rays along shared edges are what some cases are for).
+                packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
+            }
+        }
+    }
+    at::<8>();
+    at::<4>();
+}
+
+/// Traces `rays` as one coherent batch and checks every answer against the single-ray walk:
+/// identical, or a different triangle at the same distance. Returns (identical hits, ties).
+fn packets_against_single_rays<const W: usize>(
+    bvh: &BvhWide<W>,
+    mesh: &raybench_geom::TriangleMesh,
+    rays: &[raybench_geom::Ray],
+    what: &str,
+) -> (usize, usize) {
+    use raybench_accel::Accel;
+    use raybench_accel::compare::{Tolerance, Verdict, classify};
+    let prepared = bvh.prepare_coherent_rays(rays).expect("rays are valid");
+    let mut packets = vec![None; rays.len()];
+    bvh.intersect_prepared(rays, &prepared, 0, &mut packets);
+    let (mut hits, mut ties) = (0, 0);
+    for (ray, packet) in rays.iter().zip(&packets) {
+        let single = bvh.intersect(ray);
+        if *packet == single {
+            hits += single.is_some() as usize;
+            continue;
+        }
+        let tie = packet.zip(single).is_some_and(|(a, b)| a.prim != b.prim)
+            && classify(mesh, ray, *packet, single, &Tolerance::default()) == Verdict::Tie;
+        assert!(
+            tie,
+            "{what}: {ray:?}: packets {packet:?}, single ray {single:?}"
+        );
+        ties += 1;
+    }
+    (hits, ties)
+}
+
+/// Camera rays in scanline order, as the `primary` workload makes them, on scenes of every
+/// kind and from views whose rays point into several octants (an eye inside the scene looking
+/// along an axis, so the image crosses the other two axes' planes): the packet walk answers
+/// every ray as the single-ray walk does, bit for bit, except on exact ties between two
+/// triangles. Returns without checking (and says so) on a CPU without AVX-512F.
+#[test]
+fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
+    use raybench_accel::{Accel, PreparedRays};
+    use raybench_scenes::{Camera, View, primary_rays};
+    let params = WideParams {
+        coherent_packets: true,
+        ..WideParams::for_width(8)
+    };
+    let (mut hits, mut ties, mut mixed_packets) = (0usize, 0usize, 0usize);
+    for spec in [
+        "teapot-in-stadium",
+        "city",
+        "soup:triangles=20000",
+        "hair",
+        "plane:quads=64",
+    ] {
+        let scene = raybench_scenes::generate(spec, 3).expect("generates");
+        let mesh = scene.mesh.clone();
+        let bvh = Bvh8::build(mesh.clone(), &params).expect("builds");
+        if !bvh.packet_walk() {
+            eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to compare");
+            return;
+        }
+        let b = mesh.bounds();
+        let inside = View {
+            camera: Camera {
+                eye: b.center(),
+                target: b.center() + raybench_geom::Vec3::new(0.0, 0.0, -1.0),
+                up: raybench_geom::Vec3::Y,
+                fov_y_deg: 90.0,
+            },
+            light: scene.view.light,
+        };
+        for view in [scene.view, inside] {
+            let (rays, _, _) = primary_rays(&view, &b, 20_000);
+            let prepared = bvh.prepare_coherent_rays(&rays).expect("rays are valid");
+            assert!(matches!(prepared, PreparedRays::Foreign(_)));
+            let (h, t) = packets_against_single_rays(&bvh, &mesh, &rays, spec);
+            hits += h;
+            ties += t;
+            mixed_packets += rays
+                .chunks(16)
+                .filter(|c| {
+                    let octant = |r: &raybench_geom::Ray| r.inv_dir().to_array().map(|x| x < 0.0);
+                    c.iter().any(|r| octant(r) != octant(&c[0]))
+                })
+                .count();
+        }
+    }
+    eprintln!("camera rays: {hits} identical hits, {ties} ties, {mixed_packets} mixed packets");
+    assert!(hits > 50_000, "only {hits} hits: the test proves little");
+    assert!(
+        mixed_packets > 20,
+        "only {mixed_packets} packets span octants"
+    );
+    assert!(ties * 100 < hits, "{ties} ties in {hits} hits");
+}

@@ -45,6 +45,14 @@ pub struct EmbreeParams {
     pub threads: usize,
     /// Pins Embree's ISA (`isa=avx2`, …); `None` lets Embree pick the best the CPU has.
     pub isa: Option<String>,
+    /// Batches prepared as coherent (`Accel::prepare_coherent_rays`: the primary rays) are
+    /// traced for closest hit through `rtcIntersect1M` with
+    /// `RTC_INTERSECT_CONTEXT_FLAG_COHERENT`, 64 rays a call, so Embree may trace them in
+    /// packets of its own (its stream mode sorts them by octant into packets). Any hit stays
+    /// `rtcOccluded1`, as the wide BVH's packet walk is closest-hit only. Off, every ray goes
+    /// through `rtcIntersect1`/`rtcOccluded1`, hint or not.
+    #[serde(default)]
+    pub coherent_stream: bool,
 }
 
 impl EmbreeParams {
@@ -62,6 +70,14 @@ impl EmbreeParams {
     pub fn high() -> EmbreeParams {
         EmbreeParams {
             quality: Quality::High,
+            ..EmbreeParams::default()
+        }
+    }
+
+    /// Medium quality, coherent batches through Embree's stream API (`coherent_stream`).
+    pub fn medium_stream() -> EmbreeParams {
+        EmbreeParams {
+            coherent_stream: true,
             ..EmbreeParams::default()
         }
     }
@@ -87,12 +103,18 @@ impl EmbreeParams {
     }
 
     /// Registered name: `embree-<quality>`, with robust medium as `embree-robust` and other
-    /// robust qualities as `embree-<quality>-robust`.
+    /// robust qualities as `embree-<quality>-robust`; `-stream` appended with
+    /// `coherent_stream`.
     pub fn name(&self) -> String {
-        match (self.quality, self.robust) {
+        let name = match (self.quality, self.robust) {
             (q, false) => format!("embree-{}", q.name()),
             (Quality::Medium, true) => "embree-robust".to_string(),
             (q, true) => format!("embree-{}-robust", q.name()),
+        };
+        if self.coherent_stream {
+            name + "-stream"
+        } else {
+            name
         }
     }
 
@@ -119,6 +141,7 @@ mod tests {
             EmbreeParams::medium(),
             EmbreeParams::high(),
             EmbreeParams::robust(),
+            EmbreeParams::medium_stream(),
         ]
         .iter()
         .map(EmbreeParams::name)
@@ -129,7 +152,8 @@ mod tests {
                 "embree-low",
                 "embree-medium",
                 "embree-high",
-                "embree-robust"
+                "embree-robust",
+                "embree-medium-stream"
             ]
         );
         let high_robust = EmbreeParams {
@@ -157,10 +181,16 @@ mod tests {
         let json = serde_json::to_string(&EmbreeParams::robust()).unwrap();
         assert_eq!(
             json,
-            r#"{"quality":"medium","robust":true,"threads":0,"isa":null}"#
+            r#"{"quality":"medium","robust":true,"threads":0,"isa":null,"coherent_stream":false}"#
         );
         let back: EmbreeParams = serde_json::from_str(&json).unwrap();
         assert_eq!(back, EmbreeParams::robust());
+        // Reports written before the stream knob existed still read.
+        let old = r#"{"quality":"medium","robust":true,"threads":0,"isa":null}"#;
+        assert_eq!(
+            serde_json::from_str::<EmbreeParams>(old).unwrap(),
+            EmbreeParams::robust()
+        );
     }
 
     #[test]

@@ -86,6 +86,9 @@ pub(crate) fn occluded_of(ray: &RTCRay) -> bool {
 #[derive(Clone, Debug, Default)]
 pub struct PreparedEmbreeRays {
     rays: Vec<ValidRay>,
+    /// Trace through Embree's stream API with the coherent flag
+    /// ([`crate::EmbreeParams::coherent_stream`]).
+    coherent: bool,
 }
 
 impl PreparedEmbreeRays {
@@ -96,7 +99,19 @@ impl PreparedEmbreeRays {
             .enumerate()
             .map(|(index, ray)| ValidRay::new(ray).map_err(|error| InvalidRay { index, error }))
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(PreparedEmbreeRays { rays })
+        Ok(PreparedEmbreeRays {
+            rays,
+            coherent: false,
+        })
+    }
+
+    /// The same rays, to be traced through the stream API as a coherent batch or not.
+    pub(crate) fn coherent(self, coherent: bool) -> PreparedEmbreeRays {
+        PreparedEmbreeRays { coherent, ..self }
+    }
+
+    pub(crate) fn is_coherent(&self) -> bool {
+        self.coherent
     }
 
     pub fn len(&self) -> usize {

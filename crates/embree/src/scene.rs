@@ -162,6 +162,51 @@ impl EmbreeScene {
     }
 }
 
+/// Rays per `rtcIntersect1M` call: 64 (four of Embree's AVX-512 packets) keeps
+/// the copy on the stack (5 KiB) while the call's fixed cost is shared by many rays.
+const STREAM: usize = 64;
+
+impl EmbreeScene {
+    /// A coherent batch through Embree's stream API, [`STREAM`] rays a call: the checked rays
+    /// are copied to a local array (the call writes its answers into the rays).
+    fn intersect_stream(&self, batch: &[ValidRay], out: &mut [Option<Hit>]) {
+        let Some(first) = batch.first() else {
+            return;
+        };
+        let mut stream = [first.ray_hit(); STREAM];
+        for (rays, out) in batch.chunks(STREAM).zip(out.chunks_mut(STREAM)) {
+            for (s, r) in stream.iter_mut().zip(rays) {
+                *s = r.ray_hit();
+            }
+            let mut context = coherent_context();
+            // SAFETY: the scene is committed and alive; `stream` holds `rays.len()` (at most
+            // STREAM) 16-byte-aligned RTCRayHits, each built from a ray that passed
+            // `Ray::check`, laid out `size_of::<RTCRayHit>()` bytes apart; `context` is
+            // initialised as rtcInitIntersectContext does, with the coherent flag.
+            unsafe {
+                sys::rtcIntersect1M(
+                    self.scene.0,
+                    &mut context,
+                    stream.as_mut_ptr(),
+                    rays.len() as u32,
+                    std::mem::size_of::<sys::RTCRayHit>(),
+                )
+            };
+            for (o, s) in out.iter_mut().zip(&stream) {
+                *o = hit_of(s);
+            }
+        }
+    }
+}
+
+/// [`intersect_context`] with `RTC_INTERSECT_CONTEXT_FLAG_COHERENT`.
+fn coherent_context() -> sys::RTCIntersectContext {
+    sys::RTCIntersectContext {
+        flags: sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_COHERENT,
+        ..intersect_context()
+    }
+}
+
 fn new_scene(device: &Device, params: &EmbreeParams) -> Result<OwnedScene, EmbreeError> {
     // SAFETY: the device is live; a null result is checked below.
     let raw = unsafe { sys::rtcNewScene(device.raw()) };
@@ -351,6 +396,13 @@ impl Accel for EmbreeScene {
         Ok(PreparedRays::Foreign(Box::new(batch)))
     }
 
+    fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
+        let batch = self.prepare_checked(rays).map_err(|bad| bad.error)?;
+        Ok(PreparedRays::Foreign(Box::new(
+            batch.coherent(self.params.coherent_stream),
+        )))
+    }
+
     fn intersect_prepared(
         &self,
         _rays: &[Ray],
@@ -358,7 +410,11 @@ impl Accel for EmbreeScene {
         first: usize,
         out: &mut [Option<Hit>],
     ) {
-        let batch = prepared_batch(prepared).slice(first, out.len());
+        let prepared = prepared_batch(prepared);
+        let batch = prepared.slice(first, out.len());
+        if prepared.is_coherent() {
+            return self.intersect_stream(batch, out);
+        }
         for (o, &ray) in out.iter_mut().zip(batch) {
             *o = self.intersect_valid(ray);
         }
@@ -371,6 +427,9 @@ impl Accel for EmbreeScene {
         first: usize,
         out: &mut [bool],
     ) {
+        // Coherent or not, ray by ray: the packet walks compared are closest-hit ones (a
+        // coherent any-hit batch through rtcOccluded1M reported rays lying in a triangle's
+        // plane as occluded, which rtcOccluded1 and brute force do not).
         let batch = prepared_batch(prepared).slice(first, out.len());
         for (o, &ray) in out.iter_mut().zip(batch) {
             *o = self.occluded_valid(ray);

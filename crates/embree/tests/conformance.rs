@@ -23,6 +23,13 @@ fn embree_medium_conforms() {
     check(EmbreeParams::medium());
 }
 
+/// Coherent batches through `rtcIntersect1M`/`rtcOccluded1M` (the conformance suite's
+/// coherent-batch check runs them against `rtcIntersect1`).
+#[test]
+fn embree_medium_stream_conforms() {
+    check(EmbreeParams::medium_stream());
+}
+
 #[test]
 fn embree_high_conforms() {
     check(EmbreeParams::high());

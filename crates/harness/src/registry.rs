@@ -151,6 +151,15 @@ pub fn registry() -> Vec<StructureEntry> {
             None,
             |_| WideParams::for_width(8),
         ),
+        register::<Bvh8>(
+            "bvh8-packets",
+            "the bvh8-binned tree; coherent batches (primary rays) traced sixteen rays a packet, one per AVX-512 lane, every other batch ray by ray as bvh8-binned",
+            None,
+            |_| WideParams {
+                coherent_packets: true,
+                ..WideParams::for_width(8)
+            },
+        ),
         register::<KdTree>(
             "kd-sah",
             "k-d tree, SAH with perfect splits in O(N log N) (Wald–Havran 2006), early exit, mailbox",
@@ -198,6 +207,12 @@ pub fn registry() -> Vec<StructureEntry> {
             "Embree 3 BVH, RTC_BUILD_QUALITY_MEDIUM (Embree's default; the reference)",
             None,
             embree(EmbreeParams::medium()),
+        ),
+        register::<EmbreeScene>(
+            "embree-medium-stream",
+            "embree-medium; coherent batches (primary rays) traced for closest hit through rtcIntersect1M with RTC_INTERSECT_CONTEXT_FLAG_COHERENT (Embree's own packets), every other batch as embree-medium",
+            None,
+            embree(EmbreeParams::medium_stream()),
         ),
         register::<EmbreeScene>(
             "embree-high",

@@ -174,6 +174,10 @@ pub struct Validation {
     pub counts: VerdictCounts,
     /// Rays where the counted path answered differently from the timed path (a bug).
     pub counted_path_differs: u64,
+    /// Rays where the timed path (a packet walk of coherent rays) and the counted single-ray
+    /// walk report different triangles at the same distance: an order-decided tie, not a bug.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub counted_path_ties: u64,
     /// With 0 mismatches in n rays, the 95 % upper bound on the mismatch rate (rule of three).
     pub mismatch_rate_upper95: f64,
     pub first_mismatches: Vec<DisputedRay>,
@@ -196,6 +200,7 @@ impl Validation {
             reference: reference.to_string(),
             counts,
             counted_path_differs: 0,
+            counted_path_ties: 0,
             mismatch_rate_upper95: upper95,
             first_mismatches: Vec::new(),
             first_ambiguous: Vec::new(),
@@ -393,4 +398,8 @@ pub fn write_json_atomic<T: Serialize>(
     let json = serde_json::to_vec_pretty(value).with_context(|| format!("serialising {name}"))?;
     crate::atomic::write_atomic(&target, &json)?;
     Ok(target)
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }

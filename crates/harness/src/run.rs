@@ -18,7 +18,7 @@ use crate::validate::{
 };
 use anyhow::{Context, Result, bail};
 use raybench_accel::compare::Tolerance;
-use raybench_accel::{Accel, PointHit};
+use raybench_accel::{Accel, PointHit, PreparedRays};
 use raybench_embree::{Device, EmbreeParams, fpu};
 use raybench_geom::{Ray, Vec3};
 use raybench_scenes::{Scene, SuiteScene, SurfaceHit, WhittedParams, Workload};
@@ -507,7 +507,7 @@ impl<'a> SceneRun<'a> {
         let mut primary_image = None;
         for wl in self.workloads.iter().filter(|w| !w.rays.is_empty()) {
             let any_hit = wl.workload.any_hit();
-            let prepared = accel.prepare_rays(&wl.rays).map_err(|e| {
+            let prepared = prepare_workload(accel, wl.workload, &wl.rays).map_err(|e| {
                 anyhow::anyhow!(
                     "{} rays rejected by {}: {e}",
                     wl.workload.name(),
@@ -530,7 +530,9 @@ impl<'a> SceneRun<'a> {
             };
             let (mut validation, levels) =
                 validate(&s.mesh, &wl.rays, &answers, &wl.reference, &sides, tol);
-            validation.counted_path_differs = count_differences(&answers, &counted);
+            let paths = count_differences(&s.mesh, &wl.rays, &answers, &counted, tol);
+            validation.counted_path_differs = paths.differs;
+            validation.counted_path_ties = paths.ties;
             if let Some(d) = dump.as_deref_mut() {
                 d.write(
                     &s.name,
@@ -784,6 +786,19 @@ fn check_rays(wl: Workload, rays: &[Ray]) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A workload's rays prepared for `accel`'s timed path, as coherent when the workload's are.
+pub(crate) fn prepare_workload(
+    accel: &dyn Accel,
+    workload: Workload,
+    rays: &[Ray],
+) -> Result<PreparedRays, raybench_geom::RayError> {
+    if workload.coherent() {
+        accel.prepare_coherent_rays(rays)
+    } else {
+        accel.prepare_rays(rays)
+    }
 }
 
 /// A reference's answers on its timed path (the thread count changes only the speed).

@@ -130,15 +130,43 @@ pub fn count_point_differences(timed: &[Option<PointHit>], counted: &[Option<Poi
     (differing + timed.len().abs_diff(counted.len())) as u64
 }
 
-/// Rays where the counted walk answered differently from the timed path.
-pub fn count_differences(timed: &Answers, counted: &Answers) -> u64 {
+/// How the counted walk's answers compare with the timed path's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathDifferences {
+    /// Rays answered differently (a bug in one of the two paths).
+    pub differs: u64,
+    /// Closest-hit rays where the two paths report different triangles at the same distance
+    /// (a [`Verdict::Tie`]): a packet walk meets triangles in another order than the single-ray
+    /// walk, so on an exact tie it may keep the other one. Every other difference counts in
+    /// `differs`, including the same triangle at a different `t` (both paths compute a
+    /// triangle's hit with the same arithmetic).
+    pub ties: u64,
+}
+
+/// Compares the counted walk's answers with the timed path's, ray by ray.
+pub fn count_differences(
+    mesh: &TriangleMesh,
+    rays: &[Ray],
+    timed: &Answers,
+    counted: &Answers,
+    tol: &Tolerance,
+) -> PathDifferences {
+    let mut d = PathDifferences::default();
     match (timed, counted) {
         (Answers::Closest(a), Answers::Closest(b)) => {
-            a.iter().zip(b).filter(|(x, y)| x != y).count() as u64
+            for ((x, y), ray) in a.iter().zip(b).zip(rays) {
+                if x == y {
+                    continue;
+                }
+                let tie = x.zip(*y).is_some_and(|(p, q)| p.prim != q.prim)
+                    && classify(mesh, ray, *x, *y, tol) == Verdict::Tie;
+                *(if tie { &mut d.ties } else { &mut d.differs }) += 1;
+            }
         }
         (Answers::Any(a), Answers::Any(b)) => {
-            a.iter().zip(b).filter(|(x, y)| x != y).count() as u64
+            d.differs = a.iter().zip(b).filter(|(x, y)| x != y).count() as u64;
         }
-        _ => timed.len() as u64,
+        _ => d.differs = timed.len() as u64,
     }
+    d
 }

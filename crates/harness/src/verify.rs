@@ -495,9 +495,16 @@ impl Checker<'_> {
         let any_hit = wl.workload.any_hit();
         let own_indices = subject.sampled.then_some(&wr.sample[..]);
         let rays = maybe_gather(&wl.rays, own_indices);
-        let (timed, counted) = trace_both(subject.accel, &rays, any_hit, self.opts.threads)?;
-        let differs = count_differences(&timed, &counted);
+        let (timed, counted) = trace_both(
+            subject.accel,
+            wl.workload,
+            &rays,
+            any_hit,
+            self.opts.threads,
+        )?;
         let mesh = &refs.run.scene.scene.mesh;
+        let paths = count_differences(mesh, &rays, &timed, &counted, &self.tol);
+        let differs = paths.differs;
         let compare = |reference: (&str, &dyn Accel), theirs: &Answers, on_sample: bool| {
             // `on_sample`: the reference answered the subsample only; the subject's answers
             // are narrowed to it unless they already are.
@@ -585,12 +592,12 @@ fn comparison(
 /// The timed path (prepared batch, the run's threads) and the counted path, once each.
 fn trace_both(
     accel: &dyn Accel,
+    workload: Workload,
     rays: &[Ray],
     any_hit: bool,
     threads: usize,
 ) -> Result<(Answers, Answers)> {
-    let prepared = accel
-        .prepare_rays(rays)
+    let prepared = crate::run::prepare_workload(accel, workload, rays)
         .map_err(|e| anyhow::anyhow!("{} rejected a ray: {e}", accel.name()))?;
     let mut timed = Answers::new(any_hit, rays.len());
     trace_pass(accel, rays, &prepared, threads, &mut timed);

@@ -107,6 +107,12 @@ impl Workload {
         matches!(self, Workload::Shadow)
     }
 
+    /// True when consecutive rays are coherent (camera rays in scanline order): the batch is
+    /// prepared with `Accel::prepare_coherent_rays`, so structures may trace it in packets.
+    pub fn coherent(&self) -> bool {
+        matches!(self, Workload::Primary)
+    }
+
     /// True when the rays start at the primary rays' hits.
     pub fn from_hits(&self) -> bool {
         matches!(
