@@ -9,6 +9,10 @@
 //! optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round
 //! (valgrind runs no AVX-512, so there `bvh8` takes the AVX2-only loops).
 //!
+//! Primary rays are prepared as the harness prepares them, as a coherent batch, so
+//! `bvh8-packets` and `embree-medium-stream` trace them in packets (and the other workloads
+//! as `bvh8` and `embree-medium` do).
+//!
 //! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
 //! CPU without AVX-512 the two are the same code. `RB_ONLY=embree-medium,bvh8` keeps only the
 //! structures named, for profiling one structure alone; ratios are then to the first one kept
@@ -63,6 +67,11 @@ fn main() {
     add("embree-medium", &|| {
         Box::new(EmbreeScene::build(Arc::clone(&mesh), &EmbreeParams::medium()).expect("builds"))
     });
+    add("embree-medium-stream", &|| {
+        Box::new(
+            EmbreeScene::build(Arc::clone(&mesh), &EmbreeParams::medium_stream()).expect("builds"),
+        )
+    });
     add("bvh-binned", &|| {
         Box::new(Bvh::build(Arc::clone(&mesh), &BvhParams::binned()).expect("builds"))
     });
@@ -71,6 +80,13 @@ fn main() {
     });
     add("bvh8", &|| {
         Box::new(Bvh8::build(Arc::clone(&mesh), &Bvh8Params::default()).expect("builds"))
+    });
+    add("bvh8-packets", &|| {
+        let packets = Bvh8Params {
+            coherent_packets: true,
+            ..Bvh8Params::default()
+        };
+        Box::new(Bvh8::build(Arc::clone(&mesh), &packets).expect("builds"))
     });
     let sse = Bvh8Params {
         node_simd: NodeSimd::Sse,
@@ -121,7 +137,14 @@ fn main() {
         }
         let prepared: Vec<PreparedRays> = structures
             .iter()
-            .map(|(_, a, _)| a.prepare_rays(rays).expect("valid rays"))
+            .map(|(_, a, _)| {
+                // Primary rays are prepared as the harness prepares them: as a coherent batch.
+                if *name == "primary" {
+                    a.prepare_coherent_rays(rays).expect("valid rays")
+                } else {
+                    a.prepare_rays(rays).expect("valid rays")
+                }
+            })
             .collect();
         let mut rates = vec![Vec::new(); structures.len()];
         for _ in 0..rounds + 1 {
