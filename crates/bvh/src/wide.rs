@@ -167,8 +167,16 @@ impl Default for WideParams {
             // +1.0–1.4 % (two sweeps); 0.1 and 0.18 less; a leaf cap of 12 nothing. Below 0.15
             // the SAH cost with the shared constants (which price every triangle alike)
             // exceeds bvh-binned's on the bunny and the dragon (0.125: 33.4 against 31.3;
-            // 0.15: 30.5). Leaves of up to 16 (four packets) let the SAH stop early where
-            // triangles overlap.
+            // 0.15: 30.5).
+            //
+            // Leaves of at most 8 triangles (two packets, one AVX2 leaf pass): with 16, the
+            // SAH could stop early where triangles overlap, and on soup and hair the tree's
+            // SAH cost with the shared constants came out above bvh-binned's (553.0 against
+            // 454.1, 9,658.5 against 9,032.7), which issue 8 rules out. With 8 the 8-wide tree
+            // is below bvh-binned on all 17 default scenes (soup 401.9, hair 8,688.9; the
+            // bunny 22.5 → 18.7). The price, over the 17 scenes against 16 (best of 6 passes
+            // interleaved with embree-medium, this VM, 2026-11-22): primary −1.4 % single-ray
+            // and −0.4 % in packets, random −3.0 %, shadow −2.5 %.
             //
             // 64 bins, not bvh-binned's 32: over the 17 default scenes, best of 10 passes
             // interleaved in one process (this VM, 2026-11-21), primary +2.1 % and +1.6 %,
@@ -180,7 +188,7 @@ impl Default for WideParams {
                 bins: 64,
                 leaf_block: 4,
                 intersection_cost: 0.15,
-                max_leaf_size: 16,
+                max_leaf_size: 8,
                 ..BvhParams::binned()
             },
             width: MAX_WIDTH as u32,
