@@ -418,12 +418,7 @@ fn packet_walk_conforms() {
                 .chain(raybench_testkit::edge_cases())
             {
                 let bvh = BvhWide::<W>::build(case.mesh.clone(), &params).expect("builds");
-                let rays: Vec<_> = case
-                    .rays
-                    .iter()
-                    .copied()
-                    .filter(|r| r.check().is_ok())
-                    .collect();
+                let rays = raybench_testkit::valid_rays(&case);
                 // Ties are common here (rays along shared edges are what some cases are for).
                 packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
             }

@@ -124,12 +124,7 @@ fn check_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), String> {
 /// wide BVH's packet walk is held to more, bit-identical answers but for ties, in the bvh
 /// crate's tests.
 fn check_coherent_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), String> {
-    let rays: Vec<Ray> = case
-        .rays
-        .iter()
-        .copied()
-        .filter(|r| r.check().is_ok())
-        .collect();
+    let rays = valid_rays(case);
     let prepared = accel
         .prepare_coherent_rays(&rays)
         .map_err(|e| format!("{}: prepare_coherent_rays: {e}", case.name))?;
@@ -187,13 +182,18 @@ fn check_coherent_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), Str
     Ok(())
 }
 
-fn check_plain_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), String> {
-    let rays: Vec<Ray> = case
-        .rays
+/// The case's rays that pass `Ray::check` (the batch paths take only checked rays, as the
+/// harness gives them).
+pub fn valid_rays(case: &Case) -> Vec<Ray> {
+    case.rays
         .iter()
         .copied()
         .filter(|r| r.check().is_ok())
-        .collect();
+        .collect()
+}
+
+fn check_plain_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), String> {
+    let rays = valid_rays(case);
     let prepared = accel
         .prepare_rays(&rays)
         .map_err(|e| format!("{}: prepare_rays: {e}", case.name))?;
