@@ -530,11 +530,12 @@ impl<const W: usize> BvhWide<W> {
         &self.nodes
     }
 
-    /// The leaves' triangle packets, in depth-first order.
+    /// The root: a node, or a leaf when the tree is a single leaf.
     pub(crate) fn root(&self) -> ChildRef {
         self.root
     }
 
+    /// The leaves' triangle packets, in depth-first order.
     pub fn packets(&self) -> &[Tri4] {
         &self.packets
     }
