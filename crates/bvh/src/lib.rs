@@ -49,11 +49,14 @@ pub enum Builder {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BvhParams {
     pub builder: Builder,
-    /// Bins per axis for the binned builder (never more than the node has triangles). 32:
+    /// Bins per axis for the binned builder (at most; see `triangles_per_bin`). 32:
     /// measured against 8 and 16 on the bunny, Sponza, conference and dragon (1 thread,
     /// 2026-11-21): relative to 16 bins, 8 raised the SAH cost by 1.3–4.0 % and 32 lowered it
     /// by 0.04–4.7 % (conference the most) for 1.03–1.08× the build time.
     pub bins: u32,
+    /// A node gets one bin per this many triangles (at least 2, at most `bins`): 1 gives a small
+    /// node a candidate between every two centroids.
+    pub triangles_per_bin: u32,
     /// SAH cost of stepping through a node, for the builder's split decisions.
     pub traversal_cost: f32,
     /// SAH cost of one ray–triangle test, for the builder's split decisions.
@@ -87,6 +90,7 @@ impl BvhParams {
         BvhParams {
             builder: Builder::Binned,
             bins: 32,
+            triangles_per_bin: 1,
             traversal_cost: 1.0,
             intersection_cost: 1.0,
             leaf_block: 1,

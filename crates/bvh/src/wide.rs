@@ -184,8 +184,20 @@ impl Default for WideParams {
             // part is the teapot in the stadium's close-up, +14-17 % on primary rays (its
             // 219,956 centroids spread over the stadium leave the teapot in one bin of 32 for
             // more levels). 128 and 256 bins gained no more.
+            //
+            // One bin per 4 triangles in a node (bvh-binned keeps one per triangle): the sweep
+            // over the boundaries costs per bin, the binning per triangle, and below 256
+            // triangles the bins were most of a small node's work. Over the 17 default scenes
+            // against one per triangle (best of 6 passes interleaved with embree-medium, two
+            // sweeps with the roles swapped, this VM, 2026-11-22): primary −0.4 %, random
+            // −0.5 %, shadow −1.0 %, about the noise; one per 8 lost 1.5–2.1 %. The build ran
+            // 24 % fewer instructions on the bunny (callgrind; one per 8: 28 %). The SAH cost
+            // with the shared constants fell on 13 of the 16 meshes, stayed on the plane and
+            // rose on Sibenik (32.14 → 32.24) and hair (8,688.9 → 8,835.1), both still below
+            // bvh-binned (47.15, 9,032.7).
             binary: BvhParams {
                 bins: 64,
+                triangles_per_bin: 4,
                 leaf_block: 4,
                 intersection_cost: 0.15,
                 max_leaf_size: 8,

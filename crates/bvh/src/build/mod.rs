@@ -30,7 +30,9 @@ use prim::{MAX_PRIMS, Ranged};
 use raybench_accel::{BuildError, BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use raybench_geom::{Aabb, TriangleMesh};
 use rayon::prelude::*;
-use split::{PARALLEL_BINNING, Scratch, Split, binned_split, median_split, sweep_split};
+use split::{
+    PARALLEL_BINNING, Scratch, Split, binned_split, leaf_beats_any_split, median_split, sweep_split,
+};
 
 /// A built and flattened tree.
 pub(crate) struct Flat {
@@ -217,7 +219,7 @@ fn decide(
     scratch: &mut Scratch,
 ) -> Option<Split> {
     let n = refs.len();
-    if n == 1 || depth + 1 >= MAX_DEPTH {
+    if n == 1 || depth + 1 >= MAX_DEPTH || leaf_beats_any_split(p, n) {
         return None;
     }
     let split = match p.builder {

@@ -6,7 +6,7 @@
 use super::prim::{Box3, PrimRef, Ranged};
 use crate::BvhParams;
 use crate::simd::F4;
-use glam::Vec3A;
+use glam::{BVec3A, Vec3A};
 use rayon::prelude::*;
 
 /// Binning passes, and the centroid passes after a partition, over at least this many
@@ -56,6 +56,16 @@ fn blocks(p: &BvhParams, n: usize) -> f64 {
 /// otherwise only when it is cheaper than intersecting every triangle.
 fn worth_splitting(p: &BvhParams, n: usize, best_cost: f64) -> bool {
     n > p.max_leaf_size as usize || best_cost < p.intersection_cost as f64 * blocks(p, n)
+}
+
+/// Whether no split of `n` triangles can be worth taking, whatever the split: when they fit
+/// in a leaf that costs no more than one node step (with the wide tree's knobs, up to one packet
+/// of four), since a split's cost is at least the traversal cost. Such a range becomes a leaf
+/// without binning.
+pub(crate) fn leaf_beats_any_split(p: &BvhParams, n: usize) -> bool {
+    n <= p.max_leaf_size as usize
+        && p.intersection_cost >= 0.0
+        && p.intersection_cost as f64 * blocks(p, n) <= p.traversal_cost as f64
 }
 
 /// Object median: the textbook baseline. Splits any range larger than a leaf at the median
@@ -248,14 +258,11 @@ pub(crate) struct Scratch {
     sweep: Sweep,
 }
 
-/// The SAH sweep's values per boundary `b` (bins `..b` left, `b..` right) and axis.
+/// The SAH sweep's values per boundary `b` (bins `..b` left, `b..` right), one lane per axis.
 struct Sweep {
-    /// Half the area of the right side's box, and its triangles.
-    right: [([f64; 3], [u32; 3]); MAX_BINS],
-    /// Triangles on the left.
-    left_count: [[u32; 3]; MAX_BINS],
-    /// The areas weighted by the triangle tests of each side, NaN when a side is empty.
-    x: [[f64; 3]; MAX_BINS],
+    /// The right side's half area (normalised, see [`half_areas`]) weighted by its triangle
+    /// tests, and its triangles.
+    right: [(Vec3A, [u32; 3]); MAX_BINS],
 }
 
 impl Scratch {
@@ -264,12 +271,36 @@ impl Scratch {
             bins: Bins::EMPTY,
             spare: Bins::EMPTY,
             sweep: Sweep {
-                right: [([0.0; 3], [0; 3]); MAX_BINS],
-                left_count: [[0; 3]; MAX_BINS],
-                x: [[0.0; 3]; MAX_BINS],
+                right: [(Vec3A::ZERO, [0; 3]); MAX_BINS],
             },
         })
     }
+}
+
+/// Half the areas of one box per axis (`boxes[axis]`), one lane each, with coordinates scaled
+/// by `norm`. The sweep runs in f32, three axes a pass: with `norm` the inverse of the node's
+/// largest extent every extent is at most 1, so the areas weighted by triangle counts (up to
+/// 2^30) cannot overflow whatever the mesh's scale. The f64 sweep this replaced, one axis at a
+/// time, was with the choice of boundary 29 % of the 8-wide build's samples on the dragon
+/// (perf, 2 threads, this VM, 2026-11-22); the trees are the same but for rare near-ties.
+#[inline(always)]
+fn half_areas(boxes: &[Box3; 3], norm: f32) -> Vec3A {
+    let e = boxes.map(|b| b.extent() * norm);
+    let x = Vec3A::new(e[0].x, e[1].x, e[2].x);
+    let y = Vec3A::new(e[0].y, e[1].y, e[2].y);
+    let z = Vec3A::new(e[0].z, e[1].z, e[2].z);
+    x * (y + z) + y * z
+}
+
+/// The bins of a node of `n` triangles: one per `triangles_per_bin` triangles, at least 2 and
+/// at most the `bins` knob. With one bin per triangle a small node's split candidates are all
+/// covered, but the per-node cost of evaluating 3 × bins boundaries dominated small subtrees
+/// (callgrind on the bunny: 70 % of build instructions with 16 bins everywhere).
+fn bins_for(p: &BvhParams, n: usize) -> usize {
+    (n / p.triangles_per_bin.max(1) as usize)
+        .max(2)
+        .min(p.bins as usize)
+        .min(MAX_BINS)
 }
 
 /// Binned SAH (Wald 2007, "On fast construction of SAH-based bounding volume hierarchies"):
@@ -290,10 +321,7 @@ pub(crate) fn binned_split(
     if parent <= 0.0 || r.centroids.extent().max_element() <= 0.0 {
         return None;
     }
-    // No more bins than triangles: a small node's split candidates are covered by n bins,
-    // and the per-node cost of evaluating 3 × bins boundaries dominated small subtrees
-    // (callgrind on the bunny: 70 % of build instructions with 16 bins everywhere).
-    let binner = Binner::new(&r.centroids, (p.bins as usize).min(n.max(2)).min(MAX_BINS));
+    let binner = Binner::new(&r.centroids, bins_for(p, n));
     let nb = binner.bins;
     let parallel;
     let bins = if n >= PARALLEL_BINNING {
@@ -316,68 +344,63 @@ pub(crate) fn binned_split(
         &scratch.bins
     };
     let sweep = &mut scratch.sweep;
-    // The weighted area sum `x` of every boundary on all three axes first, with no branch (an
-    // invalid boundary, leaving a side empty, gets NaN; mesh coordinates are finite, so a
-    // valid one never is): the three axes interleave and nothing mispredicts. An axis of zero
-    // extent has every triangle in bin 0, so all of its boundaries are invalid.
+    // The triangle tests of `count` triangles in leaves of `leaf_block` packets, per axis.
     let block = p.leaf_block.max(1) as u64;
-    let blocks = |count: u32| -> f64 {
-        let count = count as u64;
-        if block.is_power_of_two() {
-            ((count + block - 1) & !(block - 1)) as f64
-        } else {
-            count.div_ceil(block) as f64 * block as f64
-        }
+    let tests = |count: [u32; 3]| -> Vec3A {
+        Vec3A::from_array(count.map(|c| {
+            let c = c as u64;
+            if block.is_power_of_two() {
+                ((c + block - 1) & !(block - 1)) as f32
+            } else {
+                (c.div_ceil(block) * block) as f32
+            }
+        }))
     };
+    let norm = 1.0 / r.bounds.extent().max_element();
     let (mut acc, mut count) = ([Box3::EMPTY; 3], [0u32; 3]);
     for b in (1..nb).rev() {
         for axis in 0..3 {
             acc[axis] = acc[axis].union(&bins.boxes[b][axis]);
             count[axis] += bins.counts[b][axis];
         }
-        sweep.right[b] = (acc.map(|a| a.half_area()), count);
+        sweep.right[b] = (half_areas(&acc, norm) * tests(count), count);
     }
+    // Left to right, keeping per axis the boundary with the least area-weighted triangle
+    // tests `x` (the first of equals): the SAH cost `traversal + intersection * x / parent`
+    // is least there for any positive intersection cost. No branch: a boundary that leaves a
+    // side empty gets an infinite `x` (an axis of zero extent has every triangle in bin 0,
+    // so all of its boundaries do), and the running minimum is a select.
     let (mut left, mut left_count) = ([Box3::EMPTY; 3], [0u32; 3]);
+    let (mut best_x, mut best_b) = (Vec3A::INFINITY, Vec3A::ZERO);
     for b in 1..nb {
         for axis in 0..3 {
             left[axis] = left[axis].union(&bins.boxes[b - 1][axis]);
             left_count[axis] += bins.counts[b - 1][axis];
         }
-        let left_area = left.map(|l| l.half_area());
-        let (right_area, right_count) = sweep.right[b];
-        sweep.x[b] = std::array::from_fn(|axis| {
-            let x = left_area[axis] * blocks(left_count[axis])
-                + right_area[axis] * blocks(right_count[axis]);
-            let valid = left_count[axis] > 0 && right_count[axis] > 0;
-            if valid { x } else { f64::NAN }
-        });
-        sweep.left_count[b] = left_count;
+        let (right_x, right_count) = sweep.right[b];
+        let x = half_areas(&left, norm) * tests(left_count) + right_x;
+        let valid = BVec3A::from_array(std::array::from_fn(|a| {
+            left_count[a] > 0 && right_count[a] > 0
+        }));
+        let x = Vec3A::select(valid, x, Vec3A::INFINITY);
+        let better = x.cmplt(best_x);
+        best_x = Vec3A::select(better, x, best_x);
+        best_b = Vec3A::select(better, Vec3A::splat(b as f32), best_b);
     }
-    // Then the choice, in the order the boundaries were always compared (axis by axis, left
-    // to right; the first of equal costs wins). Only `x` varies between candidates, and the
-    // cost `traversal + intersection * x / parent` never falls as `x` grows (for a positive
-    // intersection cost): so a boundary can only beat the best if its `x` is smaller, and
-    // the cost, with its division, is computed exactly as before only then.
-    let monotone = p.intersection_cost > 0.0;
-    // (cost, its x, axis, first bin on the right)
-    let mut best: Option<(f64, f64, usize, usize)> = None;
-    for axis in (0..3).filter(|&a| binner.scale[a] > 0.0) {
-        for (b, x) in sweep.x[1..nb].iter().map(|x| x[axis]).enumerate() {
-            let candidate = match best {
-                Some(best) if monotone => x < best.1,
-                _ => !x.is_nan(),
-            };
-            if !candidate {
-                continue;
-            }
-            let cost = p.traversal_cost as f64 + p.intersection_cost as f64 * x / parent;
-            if best.is_none_or(|best| cost < best.0) {
-                best = Some((cost, x, axis, b + 1));
-            }
-        }
+    // The first axis of the least `x`.
+    let axis = (1..3).fold(0, |a, b| if best_x[b] < best_x[a] { b } else { a });
+    if best_x[axis] == f32::INFINITY {
+        return None;
     }
-    let (cost, _, axis, boundary) = best?;
-    let left_count = sweep.left_count[boundary][axis];
+    let boundary = best_b[axis] as usize;
+    let parent_norm = Box3 {
+        lo: r.bounds.lo * norm,
+        hi: r.bounds.hi * norm,
+    }
+    .half_area();
+    let cost =
+        p.traversal_cost as f64 + p.intersection_cost as f64 * best_x[axis] as f64 / parent_norm;
+    let left_count: u32 = bins.counts[..boundary].iter().map(|c| c[axis]).sum();
     if !worth_splitting(p, n, cost) {
         return None;
     }
@@ -386,7 +409,15 @@ pub(crate) fn binned_split(
     // clamp can change the answer.
     let (lo, scale, limit) = (binner.min[axis], binner.scale[axis], boundary as f32);
     let mid = left_count as usize;
-    partition(refs, mid, |p| (p.centroid2_on(axis) - lo) * scale < limit);
+    // One loop per axis, so the lane is fixed inside it: with the axis a run-time index,
+    // picking the lane was a branch per record, 15 % of `decide`'s samples (perf on the
+    // dragon, 2 threads, this VM, 2026-11-22).
+    let goes_left = |c: f32| (c - lo) * scale < limit;
+    match axis {
+        0 => partition(refs, mid, |p| goes_left(p.centroid2_on(0))),
+        1 => partition(refs, mid, |p| goes_left(p.centroid2_on(1))),
+        _ => partition(refs, mid, |p| goes_left(p.centroid2_on(2))),
+    }
     // Each side's box is the union of its bins' boxes: only the centroid bounds need a pass.
     let side = |bins_range: std::ops::Range<usize>| {
         bins.boxes[bins_range]
@@ -460,4 +491,94 @@ fn partition(refs: &mut [PrimRef], mid: usize, goes_left: impl Fn(&PrimRef) -> b
     );
     debug_assert!(refs[..mid].iter().all(&goes_left));
     debug_assert!(!refs[mid..].iter().any(&goes_left));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::WideParams;
+    use raybench_geom::{Aabb, Vec3};
+
+    /// Boxes of `n` small triangles scattered in the unit cube, from a fixed seed (SplitMix64).
+    fn scattered(n: usize, seed: u64) -> Vec<Aabb> {
+        let mut state = seed;
+        let mut next = move || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n)
+            .map(|_| {
+                let lo = Vec3::new(next(), next(), next());
+                Aabb::new(lo, lo + Vec3::new(next(), next(), next()) * 0.05)
+            })
+            .collect()
+    }
+
+    fn refs_of(boxes: &[Aabb], scale: f32) -> Vec<PrimRef> {
+        let scaled = |b: &Aabb| Aabb::new(b.min * scale, b.max * scale);
+        (0..boxes.len())
+            .map(|i| PrimRef::new(&scaled(&boxes[i]), i as u32))
+            .collect()
+    }
+
+    /// The premise of [`leaf_beats_any_split`], which lets the builder skip binning: with the
+    /// wide tree's knobs no split of up to four triangles is ever taken, by the binned or the
+    /// sweep builder, and five may be.
+    #[test]
+    fn a_leaf_no_dearer_than_a_node_step_is_never_split() {
+        let wide = WideParams::default().binary;
+        assert!(leaf_beats_any_split(&wide, 4));
+        assert!(!leaf_beats_any_split(&wide, 5));
+        assert!(!leaf_beats_any_split(&BvhParams::binned(), 2));
+        for seed in 0..200 {
+            for n in 2..=4 {
+                let mut refs = refs_of(&scattered(n, seed), 1.0);
+                let r = Ranged::of(&refs, PARALLEL_BINNING);
+                let binned = binned_split(&mut refs, &r, &wide, &mut Scratch::new());
+                assert!(binned.is_none(), "seed {seed}: {n} triangles split");
+                assert!(sweep_split(&mut refs, &r, &wide).is_none());
+            }
+        }
+    }
+
+    /// The sweep runs in f32 on coordinates scaled by the node's largest extent, so the split
+    /// does not depend on the mesh's scale (powers of two scale exactly), from 2^-60 to near
+    /// the mesh limit of 1.8e18, where unscaled areas weighted by counts would overflow f32.
+    #[test]
+    fn the_binned_split_is_the_same_at_every_scale() {
+        for (seed, n) in [(1, 40), (2, 300), (3, 5000)] {
+            let boxes = scattered(n, seed);
+            let split_at = |scale: f32| {
+                let mut refs = refs_of(&boxes, scale);
+                let r = Ranged::of(&refs, PARALLEL_BINNING);
+                let p = WideParams::default().binary;
+                let s = binned_split(&mut refs, &r, &p, &mut Scratch::new()).expect("splits");
+                let left: Vec<u32> = refs[..s.mid].iter().map(PrimRef::id).collect();
+                (s.mid, left)
+            };
+            let unit = split_at(1.0);
+            assert!(0 < unit.0 && unit.0 < n);
+            for scale in [2f32.powi(-60), 2f32.powi(59)] {
+                assert_eq!(split_at(scale), unit, "seed {seed}, scale {scale:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_node_gets_a_bin_per_triangles_per_bin() {
+        let p = BvhParams {
+            bins: 64,
+            triangles_per_bin: 4,
+            ..BvhParams::binned()
+        };
+        let bins: Vec<usize> = [2, 9, 40, 255, 256, 100_000]
+            .iter()
+            .map(|&n| bins_for(&p, n))
+            .collect();
+        assert_eq!(bins, [2, 2, 10, 63, 64, 64]);
+        assert_eq!(bins_for(&BvhParams::binned(), 20), 20);
+    }
 }
