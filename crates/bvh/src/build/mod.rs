@@ -8,7 +8,8 @@
 //! * `binned_split` — binned SAH.
 //!
 //! Termination and degenerate input are handled once, in [`decide`]: a range of one triangle,
-//! or at [`MAX_DEPTH`], is a leaf; a split function returns `None` when it finds no way (or no
+//! at [`MAX_DEPTH`], or so small that its leaf costs no more than one node step (no split can
+//! then be cheaper), is a leaf; a split function returns `None` when it finds no way (or no
 //! profitable way) to separate the centroids, and then a range that fits in a leaf becomes
 //! one, while a larger range is cut in half in its current order — all centroids equal, say —
 //! so recursion always shrinks the range and always ends.
