@@ -46,10 +46,16 @@ fn split_cost(p: &BvhParams, parent: f64, left: (f64, usize), right: (f64, usize
             / parent
 }
 
-/// The triangle tests a leaf of `n` costs: `n` rounded up to whole packets of `leaf_block`.
+/// The triangle tests a leaf of `n` costs: `n` rounded up to whole packets of `leaf_block`
+/// (a mask for the usual power of two: the binned sweep calls this six times a boundary).
+#[inline(always)]
 fn blocks(p: &BvhParams, n: usize) -> f64 {
     let block = p.leaf_block.max(1) as usize;
-    n.div_ceil(block) as f64 * block as f64
+    if block.is_power_of_two() {
+        ((n + block - 1) & !(block - 1)) as f64
+    } else {
+        n.div_ceil(block) as f64 * block as f64
+    }
 }
 
 /// Whether the best split is worth taking: always when the range is too big for a leaf,
@@ -344,18 +350,8 @@ pub(crate) fn binned_split(
         &scratch.bins
     };
     let sweep = &mut scratch.sweep;
-    // The triangle tests of `count` triangles in leaves of `leaf_block` packets, per axis.
-    let block = p.leaf_block.max(1) as u64;
-    let tests = |count: [u32; 3]| -> Vec3A {
-        Vec3A::from_array(count.map(|c| {
-            let c = c as u64;
-            if block.is_power_of_two() {
-                ((c + block - 1) & !(block - 1)) as f32
-            } else {
-                (c.div_ceil(block) * block) as f32
-            }
-        }))
-    };
+    // The triangle tests of `count` triangles per axis.
+    let tests = |count: [u32; 3]| Vec3A::from_array(count.map(|c| blocks(p, c as usize) as f32));
     let norm = 1.0 / r.bounds.extent().max_element();
     let (mut acc, mut count) = ([Box3::EMPTY; 3], [0u32; 3]);
     for b in (1..nb).rev() {
@@ -393,13 +389,14 @@ pub(crate) fn binned_split(
         return None;
     }
     let boundary = best_b[axis] as usize;
-    let parent_norm = Box3 {
+    // `x` is in the scaled coordinates, so the parent's area is taken in them too.
+    let parent_scaled = Box3 {
         lo: r.bounds.lo * norm,
         hi: r.bounds.hi * norm,
     }
     .half_area();
     let cost =
-        p.traversal_cost as f64 + p.intersection_cost as f64 * best_x[axis] as f64 / parent_norm;
+        p.traversal_cost as f64 + p.intersection_cost as f64 * best_x[axis] as f64 / parent_scaled;
     let left_count: u32 = bins.counts[..boundary].iter().map(|c| c[axis]).sum();
     if !worth_splitting(p, n, cost) {
         return None;
