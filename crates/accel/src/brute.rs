@@ -3,9 +3,7 @@
 //! checked against. Ties (equal t, or equal distance for closest-point queries) resolve to the
 //! lowest primitive index.
 
-use crate::{
-    Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, Nearest, NoCount, PointHit,
-};
+use crate::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, Nearest, PointHit};
 use raybench_geom::{MollerTriangle, Ray, TriHit, Triangle, TriangleMesh, TriangleTest, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -125,34 +123,7 @@ impl Accel for BruteForce {
         &self.name
     }
 
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.trace::<false, _>(ray, &mut NoCount)
-    }
-
-    fn occluded(&self, ray: &Ray) -> bool {
-        self.trace::<true, _>(ray, &mut NoCount).is_some()
-    }
-
-    fn intersect_counted(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        self.trace::<false, _>(ray, c)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
-        self.trace::<true, _>(ray, c).is_some()
-    }
-
-    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
-        closest_point_scan(&self.mesh, p, max_radius, &mut NoCount)
-    }
-
-    fn closest_point_counted(
-        &self,
-        p: Vec3,
-        max_radius: f32,
-        c: &mut Counters,
-    ) -> Option<PointHit> {
-        closest_point_scan(&self.mesh, p, max_radius, c)
-    }
+    crate::walk_queries!();
 
     fn build_stats(&self) -> BuildStats {
         let n = self.len() as f64;
@@ -182,6 +153,7 @@ impl Accel for BruteForce {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Counters;
     use raybench_geom::Vec3;
 
     fn two_layers() -> Arc<TriangleMesh> {
@@ -299,5 +271,15 @@ mod tests {
     fn usable_as_trait_object() {
         let dynamic = crate::build_dyn::<BruteForce>(two_layers(), &Default::default()).unwrap();
         assert_eq!(dynamic.name(), "bruteforce");
+    }
+}
+
+impl crate::Walk for BruteForce {
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        self.trace::<ANY_HIT, C>(ray, c)
+    }
+
+    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
+        closest_point_scan(&self.mesh, p, max_radius, c)
     }
 }

@@ -2,22 +2,26 @@
 //!
 //! Small and stable on purpose: every structure crate and the harness depend on it.
 //! * [`Accel`]: build, closest hit, any hit, the same two with [`Counters`], stats, memory.
+//! * [`Walk`] and [`walk_queries!`]: a structure writes its traversal loops once; the macro
+//!   forwards the six query methods of [`Accel`] to them.
 //! * [`BruteForce`]: the O(N) oracle every structure is checked against.
-//! * [`compare`]: the validation classes of ARCHITECTURE.md, deciding whether two answers agree.
+//! * [`classify`]: the validation classes of ARCHITECTURE.md, deciding whether two answers agree.
 #![forbid(unsafe_code)]
 
 mod brute;
-pub mod compare;
-pub mod compare_points;
+pub mod classify;
+pub mod classify_points;
 mod counters;
 mod mailbox;
 mod nearest;
+mod walk;
 
 pub use brute::{BruteForce, BruteForceParams};
 pub use counters::{CounterSink, Counters, NoCount};
 pub use mailbox::Mailbox;
 pub use nearest::Nearest;
 pub use raybench_geom as geom;
+pub use walk::Walk;
 
 use raybench_geom::{Ray, TriangleMesh, Vec3};
 use serde::{Deserialize, Serialize};
@@ -106,7 +110,8 @@ pub enum PreparedRays {
 ///
 /// Closest hit and any hit both accept a hit at `t` only when `t_min < t <= t_max`.
 /// Implementations run one traversal loop for all four queries, generic over "any hit" and a
-/// counter sink whose non-counting form ([`NoCount`]) is zero-sized.
+/// counter sink whose non-counting form ([`NoCount`]) is zero-sized: implement [`Walk`] and
+/// write [`walk_queries!`] in the `impl Accel` block.
 pub trait Accel: Send + Sync {
     /// Named knobs; written into every report.
     type Params: Default + Clone + Debug + Serialize

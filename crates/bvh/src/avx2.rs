@@ -23,9 +23,10 @@
 //! and soup and grass 3–5 % faster (this VM, 2026-11-21).
 
 use crate::simd::F4;
-use crate::tri4::{Tri4, nearest_lane};
 use crate::wide::{BvhWide, NodeKernel, Stack, WideNode, slab_quads};
 use raybench_accel::{CounterSink, Hit, NoCount};
+use raybench_geom::Tri4;
+use raybench_geom::tri4::nearest_lane;
 use raybench_geom::{Ray, TriHit};
 use std::arch::x86_64::*;
 
@@ -322,7 +323,7 @@ fn test8(r: &Avx2Ray, a: &Tri4, b: Option<&Tri4>, t_max: f32) -> Option<(usize, 
     })
 }
 
-/// [`BvhWide::walk_ray`] compiled for AVX2, so [`test_octs`] inlines into the loop.
+/// [`BvhWide::walk_with`] compiled for AVX2, so [`test_octs`] inlines into the loop.
 #[target_feature(enable = "avx2")]
 fn walk_ray_avx2<const W: usize, const ANY_HIT: bool, C: CounterSink>(
     bvh: &BvhWide<W>,
@@ -331,7 +332,7 @@ fn walk_ray_avx2<const W: usize, const ANY_HIT: bool, C: CounterSink>(
     stack: &mut Stack,
     c: &mut C,
 ) -> Option<Hit> {
-    bvh.walk_ray::<ANY_HIT, C, Avx2Nodes>(k, ray, stack, c)
+    bvh.walk_with::<ANY_HIT, C, Avx2Nodes>(k, ray, stack, c)
 }
 
 #[inline(always)]
@@ -362,7 +363,7 @@ macro_rules! batch_loops {
             stack: &mut Stack,
         ) {
             for (o, ray) in out.iter_mut().zip(rays) {
-                *o = bvh.walk_ray::<false, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount);
+                *o = bvh.walk_with::<false, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount);
             }
         }
 
@@ -376,7 +377,7 @@ macro_rules! batch_loops {
         ) {
             for (o, ray) in out.iter_mut().zip(rays) {
                 *o = bvh
-                    .walk_ray::<true, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount)
+                    .walk_with::<true, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount)
                     .is_some();
             }
         }
@@ -425,7 +426,6 @@ pub(crate) fn occluded_all<const W: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tri4::tests::Rng;
     use crate::wide::intersect_packets;
     use raybench_geom::{MollerTriangle, Triangle, Vec3};
 
@@ -447,7 +447,7 @@ mod tests {
             eprintln!("no AVX2 on this CPU: the pair test has nothing to check");
             return;
         };
-        let mut rng = Rng(0x1eaf);
+        let mut rng = raybench_geom::SplitMix64::new(0x1eaf);
         let (mut hits, mut ties) = (0, 0);
         for case in 0..20_000usize {
             let packets_used = 1 + case % 5;
@@ -458,9 +458,9 @@ mod tests {
                     tris[k % 4]
                 } else {
                     MollerTriangle::new(&Triangle::new(
-                        rng.point(1.0),
-                        rng.point(1.0),
-                        rng.point(1.0),
+                        rng.signed_vec() * 1.0,
+                        rng.signed_vec() * 1.0,
+                        rng.signed_vec() * 1.0,
                     ))
                 };
                 tris.push(t);
@@ -473,8 +473,8 @@ mod tests {
                 })
                 .collect();
             let target = tris[case % tris.len()];
-            let origin = rng.point(3.0);
-            let (a, b) = (rng.next() * 1.2 - 0.1, rng.next() * 1.2 - 0.1);
+            let origin = rng.signed_vec() * 3.0;
+            let (a, b) = (rng.unit() * 1.2 - 0.1, rng.unit() * 1.2 - 0.1);
             let aim = target.v0 - target.e1 * a + target.e2 * (b * (1.0 - a));
             let mut dir = aim - origin;
             if case % 5 == 0 {
@@ -485,13 +485,12 @@ mod tests {
             let first = case % 9;
             // SAFETY: `detect` saw AVX2 above.
             let wide = unsafe { splat_ray(&ray) };
-            let ray4 = crate::tri4::Ray4::new(&ray);
             let run_loop = |any: bool| {
                 let (mut t, mut best) = (carried, None);
                 let stop = if any {
-                    intersect_packets::<true>(&packets, first, &ray4, &mut t, &mut best)
+                    intersect_packets::<true>(&packets, first, &ray, &mut t, &mut best)
                 } else {
-                    intersect_packets::<false>(&packets, first, &ray4, &mut t, &mut best)
+                    intersect_packets::<false>(&packets, first, &ray, &mut t, &mut best)
                 };
                 answer(stop, t, best)
             };

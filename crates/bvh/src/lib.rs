@@ -23,14 +23,13 @@ mod packet;
 mod point;
 mod simd;
 mod traverse;
-pub mod tri4;
 mod validate;
 pub mod wide;
 
 pub use node::{ChildRef, MAX_DEPTH, Node};
-pub use wide::{Bvh4, Bvh8, Bvh8Params, BvhWide, NodeSimd, WideParams};
+pub use wide::{Bvh4, Bvh8, BvhWide, NodeSimd, WideParams};
 
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount};
+use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, Walk};
 use raybench_geom::{MollerTriangle, Ray, TriangleMesh};
 use serde::Serialize;
 use std::sync::Arc;
@@ -202,46 +201,7 @@ impl Accel for Bvh {
         &self.name
     }
 
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        if self.params.ordered {
-            self.trace::<false, true, _>(ray, &mut NoCount)
-        } else {
-            self.trace::<false, false, _>(ray, &mut NoCount)
-        }
-    }
-
-    fn occluded(&self, ray: &Ray) -> bool {
-        self.trace::<true, false, _>(ray, &mut NoCount).is_some()
-    }
-
-    fn intersect_counted(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        if self.params.ordered {
-            self.trace::<false, true, _>(ray, c)
-        } else {
-            self.trace::<false, false, _>(ray, c)
-        }
-    }
-
-    fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
-        self.trace::<true, false, _>(ray, c).is_some()
-    }
-
-    fn closest_point(
-        &self,
-        p: raybench_geom::Vec3,
-        max_radius: f32,
-    ) -> Option<raybench_accel::PointHit> {
-        point::closest_point_binary(self, p, max_radius, &mut NoCount)
-    }
-
-    fn closest_point_counted(
-        &self,
-        p: raybench_geom::Vec3,
-        max_radius: f32,
-        c: &mut Counters,
-    ) -> Option<raybench_accel::PointHit> {
-        point::closest_point_binary(self, p, max_radius, c)
-    }
+    raybench_accel::walk_queries!();
 
     fn build_stats(&self) -> BuildStats {
         if self.triangles.is_empty() {
@@ -256,5 +216,25 @@ impl Accel for Bvh {
             indices: std::mem::size_of_val(self.prim_ids.as_slice()) as u64,
             primitives: std::mem::size_of_val(self.triangles.as_slice()) as u64,
         }
+    }
+}
+
+impl Walk for Bvh {
+    /// Any hit needs no order: the first hit ends the walk.
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        if !ANY_HIT && self.params.ordered {
+            self.trace::<ANY_HIT, true, C>(ray, c)
+        } else {
+            self.trace::<ANY_HIT, false, C>(ray, c)
+        }
+    }
+
+    fn walk_point<C: CounterSink>(
+        &self,
+        p: raybench_geom::Vec3,
+        max_radius: f32,
+        c: &mut C,
+    ) -> Option<raybench_accel::PointHit> {
+        point::closest_point_binary(self, p, max_radius, c)
     }
 }

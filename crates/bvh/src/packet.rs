@@ -20,7 +20,7 @@
 //!
 //! Exactness: every lane computes what the single-ray walk computes for its ray, operation for
 //! operation — the slab test with the near planes chosen by the direction's signs
-//! ([`crate::avx2`]), Möller–Trumbore as in [`crate::tri4::Tri4::intersect`] (no fused
+//! ([`crate::avx2`]), Möller–Trumbore as in [`raybench_geom::Tri4::test`] (no fused
 //! multiply-add) — so each ray's hit, `t`, `u` and `v` are the single-ray walk's, bit for bit.
 //! Only the order in which triangles are met differs, so on an exact tie (two triangles at
 //! the same `t`) the reported triangle may be the other one, as between any two structures.
@@ -33,10 +33,10 @@
 
 use crate::node::ChildRef;
 use crate::simd::F4;
-use crate::tri4::{NO_PRIM, Tri4};
 use crate::wide::{BvhWide, STACK};
 use raybench_accel::Hit;
 use raybench_geom::Ray;
+use raybench_geom::{NO_PRIM, Tri4};
 use std::arch::x86_64::*;
 
 /// Rays in a packet: one per AVX-512 lane.
@@ -310,7 +310,7 @@ fn push_sorted(stack: &mut PacketStack, base: usize, sp: &mut usize, e: Entry) {
     *sp += 1;
 }
 
-/// `a × b` lane-wise in glam's order, as [`crate::tri4::Tri4::intersect`].
+/// `a × b` lane-wise in glam's order, as [`raybench_geom::Tri4::test`].
 #[target_feature(enable = "avx512f")]
 #[inline]
 fn cross(a: &[__m512; 3], b: &[__m512; 3]) -> [__m512; 3] {

@@ -18,9 +18,9 @@
 use crate::Bvh;
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::simd::F4;
-use crate::tri4::Tri4;
 use crate::wide::{MAX_WIDTH, WideNode, quad};
 use raybench_accel::{CounterSink, Nearest, PointHit};
+use raybench_geom::Tri4;
 use raybench_geom::{Aabb, TriangleMesh, Vec3, box_distance_squared};
 
 /// The query point splatted per axis, made once per query.

@@ -85,65 +85,6 @@ mod imp {
             F4(unsafe { _mm_add_ps(self.0, o.0) })
         }
 
-        /// IEEE division, correctly rounded like the scalar `/`.
-        #[inline(always)]
-        pub fn div(self, o: F4) -> F4 {
-            // SAFETY: SSE is enabled on every x86-64 target; register-only arithmetic.
-            F4(unsafe { _mm_div_ps(self.0, o.0) })
-        }
-
-        /// Lanes with the sign bit cleared (`f32::abs`).
-        #[inline(always)]
-        pub fn abs(self) -> F4 {
-            // SAFETY: SSE is enabled on every x86-64 target; clears the sign bits only.
-            F4(unsafe { _mm_andnot_ps(_mm_set1_ps(-0.0), self.0) })
-        }
-
-        /// Lanes negated where `sign`'s lane has its sign bit set (`if s < 0 { -x } else { x }`
-        /// with `-0` counting as negative), i.e. `self ^ (sign & -0.0)`.
-        #[inline(always)]
-        pub fn flip_by_sign(self, sign: F4) -> F4 {
-            // SAFETY: SSE is enabled on every x86-64 target; bitwise register operations.
-            F4(unsafe { _mm_xor_ps(self.0, _mm_and_ps(sign.0, _mm_set1_ps(-0.0))) })
-        }
-
-        /// Lane masks (all bits set where true) of the ordered comparisons `<`, `<=`, `>=`
-        /// (false on NaN) and the unordered `!=` (true on NaN), as Rust's scalar operators.
-        #[inline(always)]
-        pub fn lt(self, o: F4) -> F4 {
-            // SAFETY: SSE is enabled on every x86-64 target; register-only compare.
-            F4(unsafe { _mm_cmplt_ps(self.0, o.0) })
-        }
-        #[inline(always)]
-        pub fn le(self, o: F4) -> F4 {
-            // SAFETY: SSE is enabled on every x86-64 target; register-only compare.
-            F4(unsafe { _mm_cmple_ps(self.0, o.0) })
-        }
-        #[inline(always)]
-        pub fn ge(self, o: F4) -> F4 {
-            // SAFETY: SSE is enabled on every x86-64 target; register-only compare.
-            F4(unsafe { _mm_cmpge_ps(self.0, o.0) })
-        }
-        #[inline(always)]
-        pub fn ne(self, o: F4) -> F4 {
-            // SAFETY: SSE is enabled on every x86-64 target; register-only compare.
-            F4(unsafe { _mm_cmpneq_ps(self.0, o.0) })
-        }
-
-        /// Bitwise and of two lane masks.
-        #[inline(always)]
-        pub fn and(self, o: F4) -> F4 {
-            // SAFETY: SSE is enabled on every x86-64 target; bitwise register operation.
-            F4(unsafe { _mm_and_ps(self.0, o.0) })
-        }
-
-        /// Bit `i` set when lane `i`'s sign bit is set (for a comparison mask: lane `i` true).
-        #[inline(always)]
-        pub fn bits(self) -> u32 {
-            // SAFETY: SSE is enabled on every x86-64 target; register-only.
-            unsafe { _mm_movemask_ps(self.0) as u32 }
-        }
-
         /// Lanes truncated towards zero to integers. Only for lanes known to lie within the
         /// i32 range (others become `i32::MIN`, `cvttps2dq`'s "indefinite" value).
         #[inline(always)]
@@ -237,52 +178,6 @@ mod imp {
         #[inline(always)]
         pub fn add(self, o: F4) -> F4 {
             F4(std::array::from_fn(|i| self.0[i] + o.0[i]))
-        }
-        #[inline(always)]
-        pub fn div(self, o: F4) -> F4 {
-            F4(std::array::from_fn(|i| self.0[i] / o.0[i]))
-        }
-        #[inline(always)]
-        pub fn abs(self) -> F4 {
-            F4(self.0.map(f32::abs))
-        }
-        #[inline(always)]
-        pub fn flip_by_sign(self, sign: F4) -> F4 {
-            F4(std::array::from_fn(|i| {
-                f32::from_bits(self.0[i].to_bits() ^ (sign.0[i].to_bits() & 0x8000_0000))
-            }))
-        }
-        #[inline(always)]
-        fn mask(f: impl Fn(usize) -> bool) -> F4 {
-            F4(std::array::from_fn(|i| {
-                f32::from_bits(if f(i) { u32::MAX } else { 0 })
-            }))
-        }
-        #[inline(always)]
-        pub fn lt(self, o: F4) -> F4 {
-            F4::mask(|i| self.0[i] < o.0[i])
-        }
-        #[inline(always)]
-        pub fn le(self, o: F4) -> F4 {
-            F4::mask(|i| self.0[i] <= o.0[i])
-        }
-        #[inline(always)]
-        pub fn ge(self, o: F4) -> F4 {
-            F4::mask(|i| self.0[i] >= o.0[i])
-        }
-        #[inline(always)]
-        pub fn ne(self, o: F4) -> F4 {
-            F4::mask(|i| self.0[i] != o.0[i])
-        }
-        #[inline(always)]
-        pub fn and(self, o: F4) -> F4 {
-            F4(std::array::from_fn(|i| {
-                f32::from_bits(self.0[i].to_bits() & o.0[i].to_bits())
-            }))
-        }
-        #[inline(always)]
-        pub fn bits(self) -> u32 {
-            (0..4).map(|i| (self.0[i].to_bits() >> 31) << i).sum()
         }
         #[inline(always)]
         pub fn trunc_i32(self) -> [i32; 4] {

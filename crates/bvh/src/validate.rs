@@ -126,7 +126,7 @@ mod tests {
     use std::sync::Arc;
 
     fn built() -> (Bvh, Arc<raybench_geom::TriangleMesh>) {
-        let mesh = raybench_scenes::generate("soup:triangles=500", 3)
+        let mesh = raybench_testkit::scenes::generate("soup:triangles=500", 3)
             .unwrap()
             .mesh;
         (

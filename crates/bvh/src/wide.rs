@@ -33,12 +33,12 @@ use crate::BvhParams;
 use crate::build::{self, Box3, PrimRef};
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::simd::{F4, prefetch};
-use crate::tri4::{NO_PRIM, Ray4, Tri4};
 use raybench_accel::{
-    Accel, BuildError, BuildStats, CounterSink, Counters, Hit, Memory, NoCount, PreparedRays,
-    SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST,
+    Accel, BuildError, BuildStats, CounterSink, Hit, Memory, NoCount, PreparedRays,
+    SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST, Walk,
 };
 use raybench_geom::{Aabb, MollerTriangle, Ray, RayError, TriHit, TriangleMesh, Vec3};
+use raybench_geom::{NO_PRIM, Tri4};
 use serde::Serialize;
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -141,9 +141,6 @@ pub struct WideParams {
     /// ray. The registry's `bvh8-packets`.
     pub coherent_packets: bool,
 }
-
-/// The 8-wide tree's knobs (the name the reports and tests have used since issue 8 began).
-pub type Bvh8Params = WideParams;
 
 impl WideParams {
     /// The defaults for nodes of `width` children.
@@ -758,11 +755,12 @@ pub(crate) trait NodeKernel<const W: usize>: Copy {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SseNodes;
 
-/// The ray as [`SseNodes`] needs it: the packet test's splatted ray (whose origin the node
-/// test shares), the inverse direction splatted, and per axis which stored side (min or max)
-/// holds the near planes.
+/// The ray as [`SseNodes`] needs it: the ray itself (for the leaves' [`Tri4`] tests), its
+/// origin and inverse direction splatted, and per axis which stored side (min or max) holds
+/// the near planes.
 pub(crate) struct WideRay {
-    ray4: Ray4,
+    ray: Ray,
+    origin: [F4; 3],
     inv: [F4; 3],
     near: [bool; 3],
 }
@@ -777,7 +775,8 @@ impl<const W: usize> NodeKernel<W> for SseNodes {
             inv: inv.map(F4::splat),
             // -0 counts as negative: its inverse is -inf (bug class B3).
             near: inv.map(|x| x.is_sign_negative()),
-            ray4: Ray4::new(ray),
+            origin: ray.origin().to_array().map(F4::splat),
+            ray: *ray,
         }
     }
 
@@ -790,12 +789,12 @@ impl<const W: usize> NodeKernel<W> for SseNodes {
         best_t: &mut f32,
         best: &mut Option<(usize, TriHit)>,
     ) -> bool {
-        intersect_packets::<ANY_HIT>(packets, first, &ray.ray4, best_t, best)
+        intersect_packets::<ANY_HIT>(packets, first, &ray.ray, best_t, best)
     }
 
     #[inline(always)]
     fn test(self, r: &WideRay, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]) {
-        slab_quads(&r.ray4.origin, &r.inv, r.near, n, t_min, t_max)
+        slab_quads(&r.origin, &r.inv, r.near, n, t_min, t_max)
     }
 }
 
@@ -919,7 +918,7 @@ fn nearest_first<const W: usize>(
 pub(crate) fn intersect_packets<const ANY_HIT: bool>(
     packets: &[Tri4],
     first: usize,
-    ray: &Ray4,
+    ray: &Ray,
     best_t: &mut f32,
     best: &mut Option<(usize, TriHit)>,
 ) -> bool {
@@ -940,7 +939,7 @@ impl<const W: usize> BvhWide<W> {
     /// kernel. `stack` is scratch space, so batch callers reuse one allocation for all their
     /// rays. There is no separate test of the root box: the root node's test covers it.
     #[inline(always)]
-    pub(crate) fn walk_ray<const ANY_HIT: bool, C: CounterSink, K: NodeKernel<W>>(
+    pub(crate) fn walk_with<const ANY_HIT: bool, C: CounterSink, K: NodeKernel<W>>(
         &self,
         kernel: K,
         ray: &Ray,
@@ -1015,7 +1014,7 @@ impl<const W: usize> BvhWide<W> {
         }
     }
 
-    /// [`BvhWide::walk_ray`] with the kernel chosen at build time.
+    /// [`BvhWide::walk_with`] with the kernel chosen at build time.
     #[inline(always)]
     fn trace<const ANY_HIT: bool, C: CounterSink>(
         &self,
@@ -1027,7 +1026,7 @@ impl<const W: usize> BvhWide<W> {
         if let Some(k) = self.avx2 {
             return crate::avx2::walk_ray::<W, ANY_HIT, C>(self, k, ray, stack, c);
         }
-        self.walk_ray::<ANY_HIT, C, SseNodes>(SseNodes, ray, stack, c)
+        self.walk_with::<ANY_HIT, C, SseNodes>(SseNodes, ray, stack, c)
     }
 
     fn trace_single<const ANY_HIT: bool, C: CounterSink>(
@@ -1098,34 +1097,7 @@ impl<const W: usize> Accel for BvhWide<W> {
         }
     }
 
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.trace_single::<false, _>(ray, &mut NoCount)
-    }
-
-    fn occluded(&self, ray: &Ray) -> bool {
-        self.trace_single::<true, _>(ray, &mut NoCount).is_some()
-    }
-
-    fn intersect_counted(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        self.trace_single::<false, _>(ray, c)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
-        self.trace_single::<true, _>(ray, c).is_some()
-    }
-
-    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<raybench_accel::PointHit> {
-        crate::point::closest_point_wide(&self.point_view(), p, max_radius, &mut NoCount)
-    }
-
-    fn closest_point_counted(
-        &self,
-        p: Vec3,
-        max_radius: f32,
-        c: &mut Counters,
-    ) -> Option<raybench_accel::PointHit> {
-        crate::point::closest_point_wide(&self.point_view(), p, max_radius, c)
-    }
+    raybench_accel::walk_queries!();
 
     /// With the packet walk, the rays are laid out in packets of sixteen, structure of arrays
     /// (as Embree's stream takes `RTCRayHit`s, converted outside timing); without it, as they
@@ -1246,5 +1218,20 @@ impl<const W: usize> BvhWide<W> {
         s.nodes += s.leaves;
         s.sah_cost = (root_area > 0.0).then_some(sah);
         s
+    }
+}
+
+impl<const W: usize> Walk for BvhWide<W> {
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        self.trace_single::<ANY_HIT, C>(ray, c)
+    }
+
+    fn walk_point<C: CounterSink>(
+        &self,
+        p: Vec3,
+        max_radius: f32,
+        c: &mut C,
+    ) -> Option<raybench_accel::PointHit> {
+        crate::point::closest_point_wide(&self.point_view(), p, max_radius, c)
     }
 }

@@ -1,6 +1,6 @@
 //! The shared conformance suite for every BVH variant, `validate()` after every build.
 
-use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, BvhWide, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, BvhWide, WideParams};
 use raybench_testkit::conformance;
 
 fn check(params: BvhParams) {
@@ -91,7 +91,7 @@ fn four_wide_conforms() {
 #[test]
 fn a_width_other_than_the_trees_is_refused() {
     use raybench_accel::{Accel, BuildError};
-    let mesh = raybench_scenes::generate("soup:triangles=100", 1)
+    let mesh = raybench_testkit::scenes::generate("soup:triangles=100", 1)
         .expect("generates")
         .mesh;
     for r in [
@@ -111,7 +111,7 @@ fn a_width_other_than_the_trees_is_refused() {
 #[test]
 fn both_widths_share_the_leaves_and_differ_in_depth() {
     use raybench_accel::Accel;
-    let mesh = raybench_scenes::generate("teapot:triangles=20000", 1)
+    let mesh = raybench_testkit::scenes::generate("teapot:triangles=20000", 1)
         .expect("generates")
         .mesh;
     let unfilled = |width| WideParams {
@@ -145,7 +145,9 @@ fn both_widths_share_the_leaves_and_differ_in_depth() {
 fn filling_slots_splits_leaves_and_lowers_the_sah() {
     fn check<const W: usize>(spec: &str) {
         use raybench_accel::Accel;
-        let mesh = raybench_scenes::generate(spec, 1).expect("generates").mesh;
+        let mesh = raybench_testkit::scenes::generate(spec, 1)
+            .expect("generates")
+            .mesh;
         let with = |fill_slots| {
             let p = WideParams {
                 fill_slots,
@@ -198,7 +200,7 @@ fn wide_trees_are_the_same_with_one_and_two_threads() {
         assert!(one.nodes() == two.nodes(), "{W} wide: nodes differ");
         assert!(one.packets() == two.packets(), "{W} wide: packets differ");
     }
-    let mesh = raybench_scenes::generate("teapot:triangles=20000", 1)
+    let mesh = raybench_testkit::scenes::generate("teapot:triangles=20000", 1)
         .expect("generates")
         .mesh;
     check::<8>(&mesh);
@@ -217,7 +219,7 @@ fn sse_matches_avx2_at<const W: usize>() {
     };
     let counts = conformance::<BvhWide<W>>(&sse, &|b, mesh| b.validate(mesh));
     assert_eq!(counts.mismatch, 0);
-    let mesh = raybench_scenes::generate("teapot:triangles=5000", 1)
+    let mesh = raybench_testkit::scenes::generate("teapot:triangles=5000", 1)
         .expect("generates")
         .mesh;
     for max_leaf_size in [4, 16] {
@@ -228,7 +230,7 @@ fn sse_matches_avx2_at<const W: usize>() {
         };
         let (a, b) = (with(&WideParams::for_width(W as u32)), with(&sse));
         assert!(!b.uses_avx2());
-        for ray in raybench_scenes::random_rays(&mesh.bounds(), 5_000, 7) {
+        for ray in raybench_testkit::scenes::random_rays(&mesh.bounds(), 5_000, 7) {
             let (mut ca, mut cb) = (Counters::default(), Counters::default());
             assert_eq!(
                 a.intersect_counted(&ray, &mut ca),
@@ -247,7 +249,7 @@ fn sse_matches_avx2_at<const W: usize>() {
 fn avx2_only_conforms_at<const W: usize>() {
     use raybench_accel::Accel;
     let auto = BvhWide::<W>::build(
-        raybench_scenes::generate("sphere:triangles=200", 1)
+        raybench_testkit::scenes::generate("sphere:triangles=200", 1)
             .expect("generates")
             .mesh,
         &WideParams::for_width(W as u32),
@@ -292,7 +294,7 @@ fn four_wide_sse_kernel_conforms_and_matches_the_default() {
 #[test]
 fn wide_conforms_on_the_shared_scenes() {
     let checked =
-        raybench_testkit::conformance_on_shared_scenes::<Bvh8>(&Bvh8Params::default(), &|b, m| {
+        raybench_testkit::conformance_on_shared_scenes::<Bvh8>(&WideParams::default(), &|b, m| {
             b.validate(m)
         });
     let four = raybench_testkit::conformance_on_shared_scenes::<Bvh4>(
@@ -327,14 +329,14 @@ fn binary_point_queries_conform() {
 #[test]
 fn wide_point_queries_conform() {
     use raybench_testkit::points::point_conformance;
-    let tiny = Bvh8Params {
+    let tiny = WideParams {
         binary: BvhParams {
             max_leaf_size: 1,
             ..BvhParams::binned()
         },
-        ..Bvh8Params::default()
+        ..WideParams::default()
     };
-    for params in [Bvh8Params::default(), tiny] {
+    for params in [WideParams::default(), tiny] {
         let counts = point_conformance::<Bvh8>(&params, &|b, m| b.validate(m));
         assert_eq!(counts.mismatch, 0, "{params:?}");
     }
@@ -354,7 +356,7 @@ fn point_queries_conform_on_the_shared_scenes() {
         30,
     );
     let wide = point_conformance_on_shared_scenes::<Bvh8>(
-        &Bvh8Params::default(),
+        &WideParams::default(),
         &|b, m| b.validate(m),
         70,
         30,
@@ -367,7 +369,7 @@ fn point_queries_conform_on_the_shared_scenes() {
 #[test]
 fn too_large_is_an_error_not_an_abort() {
     use raybench_accel::{Accel, BuildError};
-    let mesh = raybench_scenes::generate("soup:triangles=2000", 1)
+    let mesh = raybench_testkit::scenes::generate("soup:triangles=2000", 1)
         .expect("generates")
         .mesh;
     let small = BvhParams {
@@ -382,9 +384,9 @@ fn too_large_is_an_error_not_an_abort() {
         other => panic!("expected TooLarge, got {other:?}"),
     };
     refused(Bvh::build(mesh.clone(), &small).map(|_| ()));
-    let wide = Bvh8Params {
+    let wide = WideParams {
         binary: small.clone(),
-        ..Bvh8Params::default()
+        ..WideParams::default()
     };
     refused(Bvh8::build(mesh.clone(), &wide).map(|_| ()));
     let four = WideParams {
@@ -437,7 +439,7 @@ fn packets_against_single_rays<const W: usize>(
     what: &str,
 ) -> (usize, usize) {
     use raybench_accel::Accel;
-    use raybench_accel::compare::{Tolerance, Verdict, classify};
+    use raybench_accel::classify::{Tolerance, Verdict, classify};
     let prepared = bvh.prepare_coherent_rays(rays).expect("rays are valid");
     let mut packets = vec![None; rays.len()];
     bvh.intersect_prepared(rays, &prepared, 0, &mut packets);
@@ -468,7 +470,7 @@ fn packets_against_single_rays<const W: usize>(
 #[test]
 fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
     use raybench_accel::{Accel, PreparedRays};
-    use raybench_scenes::{Camera, View, primary_rays};
+    use raybench_testkit::scenes::{Camera, View, primary_rays};
     let params = WideParams {
         coherent_packets: true,
         ..WideParams::for_width(8)
@@ -481,7 +483,7 @@ fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
         "hair",
         "plane:quads=64",
     ] {
-        let scene = raybench_scenes::generate(spec, 3).expect("generates");
+        let scene = raybench_testkit::scenes::generate(spec, 3).expect("generates");
         let mesh = scene.mesh.clone();
         let bvh = Bvh8::build(mesh.clone(), &params).expect("builds");
         if !bvh.packet_walk() {

@@ -5,7 +5,7 @@
 mod common;
 
 use common::{height_field, presets, random_triangles, workload};
-use raybench_accel::compare::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
+use raybench_accel::classify::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
 use raybench_accel::{Accel, BruteForce, BruteForceParams, Hit};
 use raybench_embree::EmbreeScene;
 use raybench_geom::{Ray, TriangleMesh};

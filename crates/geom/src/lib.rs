@@ -7,8 +7,11 @@
 //! * [`Triangle`] and [`TriangleMesh`], with the two ray–triangle tests raybench uses:
 //!   Möller–Trumbore in the form Embree's fast mode uses, and the watertight test of
 //!   Woop, Benthin and Wald (2013).
+//! * [`Tri4`]: four triangles tested against one ray at once, bit-identical to the scalar
+//!   Möller–Trumbore test (the wide BVH's leaves, the grid's triangle store).
 //! * [`closest_point_on_triangle`] (Ericson's region test) and [`box_distance_squared`], for
 //!   closest-point queries.
+//! * [`SplitMix64`]: the one small seeded generator of the workspace.
 //!
 //! No `unsafe`, no acceleration structures.
 #![forbid(unsafe_code)]
@@ -17,8 +20,8 @@ mod aabb;
 mod mesh;
 mod point;
 mod ray;
-#[cfg(test)]
-mod test_rng;
+pub mod rng;
+pub mod tri4;
 mod triangle;
 pub mod tribox;
 
@@ -29,6 +32,8 @@ pub use point::{
     box_distance_squared, closest_point_on_triangle, distance_to_triangle_f64, query_radius_squared,
 };
 pub use ray::{EMBREE_LARGE, Ray, RayError};
+pub use rng::SplitMix64;
+pub use tri4::{NO_PRIM, Tri4, Tri4Hits};
 pub use triangle::{MollerTriangle, TriHit, Triangle, TriangleTest};
 
 /// Largest finite value that still compares correctly: `max` of two floats, ignoring a NaN in

@@ -149,7 +149,7 @@ fn segment_distance_f64(p: DVec3, s: DVec3, e: DVec3) -> f64 {
 mod tests {
     use super::*;
 
-    use crate::test_rng::SplitMix as Rng;
+    use crate::rng::SplitMix64 as Rng;
 
     /// The shapes the region method must survive, each a function of the stream.
     #[derive(Clone, Copy, Debug)]
@@ -209,7 +209,7 @@ mod tests {
         let b = t.bounds();
         let size = b.diagonal().max(1e-6 * b.max.abs().max_element().max(1.0));
         let near = b.center() + rng.signed_vec() * size;
-        if rng.next().is_multiple_of(4) {
+        if rng.next_u64().is_multiple_of(4) {
             // Exactly in the plane of (v0, v1): the in-plane regions, where signs are closest to 0.
             t.v0 + (t.v1 - t.v0) * (rng.signed() * 2.0) + (t.v2 - t.v0) * rng.signed()
         } else {
@@ -261,7 +261,7 @@ mod tests {
     /// with the f64 reference. The reference passes the same sampling test.
     #[test]
     fn region_method_matches_dense_sampling() {
-        let mut rng = Rng(0x5eed_9001);
+        let mut rng = Rng::new(0x5eed_9001);
         let mut worst_ulps = 0.0f64;
         for shape in SHAPES {
             for _ in 0..150 {
@@ -358,7 +358,7 @@ mod tests {
     /// checked against the f64 reference on random boxes and triangles inside them.
     #[test]
     fn box_distance_is_a_lower_bound_of_the_contents() {
-        let mut rng = Rng(0x5eed_9002);
+        let mut rng = Rng::new(0x5eed_9002);
         for shape in SHAPES {
             for _ in 0..500 {
                 let t = random_triangle(&mut rng, shape);

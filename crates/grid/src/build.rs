@@ -18,18 +18,19 @@
 //! Storage is one offsets array (cells + 1 entries) into one reference array, never a `Vec`
 //! per cell: insertion (parallel over chunks of triangles) emits `(cell, triangle)` pairs in
 //! triangle order, then a counting pass and a prefix sum give the offsets and a scatter fills
-//! the references, ascending within each cell. Triangles are stored four to a packet in mesh
-//! order ([`crate::packet`]); meshes list neighbouring triangles together, so a cell's
-//! references mostly fall into a few packets, each tested four lanes at a time, with no copy
+//! the references, ascending within each cell. Triangles are stored four to a
+//! [`raybench_geom::Tri4`] in mesh order; meshes list neighbouring triangles together, so a
+//! cell's references mostly fall into a few Tri4s, each tested four lanes at a time, with no copy
 //! of a triangle per cell. Memory is
 //! estimated before every allocation (offsets and triangle copies from the resolution,
 //! references counted as they are emitted) and the build stops with
 //! [`BuildError::TooLarge`] past [`GridParams::memory_limit_bytes`] instead of exhausting
 //! memory.
 
-use crate::packet::{LANES, Packet};
 use crate::{Grid, GridParams};
 use raybench_accel::{BuildError, BuildStats};
+use raybench_geom::Tri4;
+use raybench_geom::tri4::LANES;
 use raybench_geom::tribox::{MARGIN_REL, TriBox};
 use raybench_geom::{Aabb, DVec3, MollerTriangle, Triangle, TriangleMesh};
 use rayon::prelude::*;
@@ -321,18 +322,18 @@ pub(crate) fn build(mesh: &Arc<TriangleMesh>, params: &GridParams) -> Result<Gri
     }
     offsets[0] = 0;
 
-    // The triangles in mesh order, four to a packet: triangle `i` is lane `i % 4` of packet
+    // The triangles in mesh order, four to a Tri4: triangle `i` is lane `i % 4` of Tri4
     // `i / 4`. Meshes list neighbouring triangles together (scans, strips, generators), so a
-    // cell's ascending references mostly fall into a few packets.
-    let triangles: Vec<Packet> = (0..n.div_ceil(LANES))
+    // cell's ascending references mostly fall into a few Tri4s.
+    let triangles: Vec<Tri4> = (0..n.div_ceil(LANES))
         .into_par_iter()
         .map(|k| {
-            let mut packet = Packet::empty();
+            let mut four = Tri4::default();
             for l in 0..LANES.min(n - k * LANES) {
                 let id = k * LANES + l;
-                packet.set(l, id as u32, &MollerTriangle::new(&mesh.triangle(id)));
+                four.set_lane(l, id as u32, &MollerTriangle::new(&mesh.triangle(id)));
             }
-            packet
+            four
         })
         .collect();
     let mut occupied = vec![0u64; cells.div_ceil(64)];

@@ -25,13 +25,13 @@
 #![forbid(unsafe_code)]
 
 pub mod build;
-mod packet;
 mod points;
 mod traverse;
 mod validate;
 
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount, PointHit};
-use raybench_geom::{Aabb, Ray, TriangleMesh, Vec3};
+use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, Walk};
+use raybench_geom::tri4::LANES;
+use raybench_geom::{Aabb, Ray, Tri4, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -54,11 +54,10 @@ pub struct GridParams {
 
 impl GridParams {
     /// λ = 1: measured against 0.5, 1.5, 2, 3 and 4 on the bunny, grass, terrain and
-    /// conference (100k primary and 100k random rays each, 1 thread, 4-wide packet tests;
-    /// issue-6 note): the fastest or within 10 % of it on every scene and workload, and the
+    /// conference (100k primary and 100k random rays each, 1 thread, four-lane triangle tests): the fastest or within 10 % of it on every scene and workload, and the
     /// cheapest build of those; λ = 2 traced 4–13 % slower on the bunny, terrain and conference
     /// (grass: 6 % faster on random rays, 6 % slower on primary); λ = 4 was 10–25 % slower
-    /// everywhere. (Before the packet tests made triangle tests cheap, λ = 2 was best.)
+    /// everywhere. (With one triangle tested at a time, λ = 2 was best.)
     pub const DEFAULT_DENSITY: f64 = 1.0;
     /// λ = 1/8: "too few cells" (cells hold dozens of triangles).
     pub const COARSE_DENSITY: f64 = 0.125;
@@ -105,7 +104,7 @@ impl Default for GridParams {
 }
 
 /// A built grid. Cell `(x, y, z)` has linear index `x + nx·(y + ny·z)`; its triangles are
-/// `refs[offsets[i]..offsets[i + 1]]`, stored in packets of four in Embree's precomputed
+/// `refs[offsets[i]..offsets[i + 1]]`, stored four to a [`Tri4`] in Embree's precomputed
 /// layout.
 #[derive(Debug)]
 pub struct Grid {
@@ -127,11 +126,11 @@ pub struct Grid {
     occupied: Vec<u64>,
     /// Triangle ids, ascending within each cell.
     refs: Vec<u32>,
-    /// The triangles in mesh order, four to a packet: triangle `i` is lane `i % 4` of packet
-    /// `i / 4`.
-    triangles: Vec<packet::Packet>,
+    /// The triangles in mesh order, four to a [`Tri4`]: triangle `i` is lane `i % 4` of
+    /// `triangles[i / 4]`.
+    triangles: Vec<Tri4>,
     stats: BuildStats,
-    /// The mesh, for the exact vertices closest-point queries need (the packets hold
+    /// The mesh, for the exact vertices closest-point queries need (the [`Tri4`]s hold
     /// Möller–Trumbore's edge form, which does not give the vertices back bit for bit).
     mesh: Arc<TriangleMesh>,
 }
@@ -156,7 +155,7 @@ impl Grid {
 
     /// The mesh id of internal triangle `i`.
     fn mesh_id(&self, i: u32) -> u32 {
-        self.triangles[i as usize / packet::LANES].ids[i as usize % packet::LANES]
+        self.triangles[i as usize / LANES].ids[i as usize % LANES]
     }
 
     /// Checks the invariants (see [`validate`]).
@@ -184,34 +183,7 @@ impl Accel for Grid {
         &self.name
     }
 
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.trace::<false, _>(ray, &mut NoCount)
-    }
-
-    fn occluded(&self, ray: &Ray) -> bool {
-        self.trace::<true, _>(ray, &mut NoCount).is_some()
-    }
-
-    fn intersect_counted(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        self.trace::<false, _>(ray, c)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
-        self.trace::<true, _>(ray, c).is_some()
-    }
-
-    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
-        self.closest(p, max_radius, &mut NoCount)
-    }
-
-    fn closest_point_counted(
-        &self,
-        p: Vec3,
-        max_radius: f32,
-        c: &mut Counters,
-    ) -> Option<PointHit> {
-        self.closest(p, max_radius, c)
-    }
+    raybench_accel::walk_queries!();
 
     fn build_stats(&self) -> BuildStats {
         self.stats.clone()
@@ -223,7 +195,7 @@ impl Accel for Grid {
             .iter()
             .map(|p| std::mem::size_of_val(p.as_slice()))
             .sum();
-        let ids = (self.triangles.len() * packet::LANES * 4) as u64;
+        let ids = (self.triangles.len() * LANES * 4) as u64;
         Memory {
             nodes: (std::mem::size_of_val(self.offsets.as_slice())
                 + std::mem::size_of_val(self.occupied.as_slice())
@@ -231,5 +203,15 @@ impl Accel for Grid {
             indices: std::mem::size_of_val(self.refs.as_slice()) as u64 + ids,
             primitives: std::mem::size_of_val(self.triangles.as_slice()) as u64 - ids,
         }
+    }
+}
+
+impl Walk for Grid {
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        self.trace::<ANY_HIT, C>(ray, c)
+    }
+
+    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
+        self.closest(p, max_radius, c)
     }
 }

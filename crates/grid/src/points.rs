@@ -222,7 +222,7 @@ impl Grid {
             return true;
         }
         let p = s.p;
-        // References are mesh triangle ids (the packets keep mesh order, `build.rs`).
+        // References are mesh triangle ids (the Tri4s keep mesh order, `build.rs`).
         for &prim in &self.refs[self.offsets[u] as usize..self.offsets[u + 1] as usize] {
             if s.mailbox.seen(prim) {
                 s.counters.mailbox_skip();

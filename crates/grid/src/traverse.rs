@@ -14,9 +14,9 @@
 //!   is at or beyond it — or at the end of the ray or of the grid. Every iteration steps one
 //!   axis towards the grid's side, so the walk is bounded by `nx + ny + nz` cells even for NaN
 //!   input.
-//! * Tests: a cell's references are grouped by the packet of four they fall in and each group
-//!   is tested four lanes at a time ([`crate::packet`]), with lanes the cell does not
-//!   reference or the ray has tested already masked out.
+//! * Tests: a cell's references are grouped by the [`raybench_geom::Tri4`] they fall in and
+//!   each group is tested four lanes at a time, with lanes the cell does not reference or the
+//!   ray has tested already masked out.
 //! * Mailbox: a direct-mapped table of the last [`MAILBOX`] triangle ids tested, on the stack
 //!   (no allocation, `&self` stays shareable across threads). A triangle met again in a later
 //!   cell is skipped: its hit, if any, is already the closest hit so far or was beaten by a
@@ -24,8 +24,8 @@
 //!   collision only costs a repeated test.
 
 use crate::Grid;
-use crate::packet::LANES;
 use raybench_accel::{CounterSink, Hit};
+use raybench_geom::tri4::LANES;
 use raybench_geom::{Ray, TriHit, max_keep};
 
 /// Mailbox slots (a power of two). 32, not tuned: a ray rarely meets more distinct straddling
@@ -121,10 +121,10 @@ impl Grid {
                 let list = &self.refs[first..last];
                 let mut i = 0;
                 while i < list.len() {
-                    // The run of references in one packet (lists are ascending), minus the
+                    // The run of references in one Tri4 (lists are ascending), minus the
                     // triangles this ray has tested already.
                     let group = list[i] as usize / LANES;
-                    let mut active = 0u8;
+                    let mut active = 0u32;
                     while i < list.len() && list[i] as usize / LANES == group {
                         let id = list[i];
                         i += 1;
@@ -138,8 +138,8 @@ impl Grid {
                         continue;
                     }
                     c.prim_tests(active.count_ones() as u64);
-                    let packet = &self.triangles[group];
-                    let hits = packet.intersect(ray, best_t);
+                    let four = &self.triangles[group];
+                    let hits = four.test(ray, best_t);
                     let mut mask = hits.mask & active;
                     if mask == 0 {
                         continue;
@@ -157,7 +157,7 @@ impl Grid {
                     }
                     if let Some((l, h)) = pick {
                         best_t = h.t;
-                        best = Some((packet.ids[l], h));
+                        best = Some((four.ids[l], h));
                         if ANY_HIT {
                             break;
                         }

@@ -2,7 +2,7 @@
 
 use crate::Grid;
 use crate::build::Layout;
-use crate::packet::{EMPTY, LANES};
+use raybench_geom::tri4::{LANES, NO_PRIM};
 use raybench_geom::tribox::{MARGIN_REL, TriBox};
 use raybench_geom::{DVec3, MollerTriangle, Triangle, TriangleMesh, Vec3};
 
@@ -19,7 +19,7 @@ fn widened((lo, hi): (DVec3, DVec3), f: f64) -> (DVec3, DVec3) {
     (lo - DVec3::splat(m), hi + DVec3::splat(m))
 }
 
-/// The layout is the one the mesh and parameters call for; the packets hold every mesh
+/// The layout is the one the mesh and parameters call for; the Tri4s hold every mesh
 /// triangle exactly once as an exact copy (empty lanes only past the last); the offsets tile
 /// the reference array and agree with the occupancy bits; every cell's list is strictly
 /// ascending (no duplicates); and every triangle is in
@@ -49,10 +49,10 @@ pub(crate) fn validate(grid: &Grid, mesh: &TriangleMesh) -> Result<(), String> {
             ));
         }
     }
-    // The packets: internal ids 0..n name every mesh triangle once, each lane an exact copy.
+    // The Tri4s: internal ids 0..n name every mesh triangle once, each lane an exact copy.
     if grid.triangles.len() != n.div_ceil(LANES) {
         return Err(format!(
-            "{} packets for a mesh of {n} triangles",
+            "{} Tri4s for a mesh of {n} triangles",
             grid.triangles.len()
         ));
     }
@@ -63,7 +63,7 @@ pub(crate) fn validate(grid: &Grid, mesh: &TriangleMesh) -> Result<(), String> {
             let internal = k * LANES + l;
             let id = p.ids[l];
             if internal >= n {
-                if id != EMPTY || p.get(l) != empty_lane {
+                if id != NO_PRIM || p.lane(l) != empty_lane {
                     return Err(format!("lane {internal} past the mesh is not empty"));
                 }
                 continue;
@@ -75,7 +75,7 @@ pub(crate) fn validate(grid: &Grid, mesh: &TriangleMesh) -> Result<(), String> {
                 return Err(format!("triangle {id} is stored twice"));
             }
             *slot = internal as u32;
-            if p.get(l) != MollerTriangle::new(&mesh.triangle(id as usize)) {
+            if p.lane(l) != MollerTriangle::new(&mesh.triangle(id as usize)) {
                 return Err(format!(
                     "lane {internal}: the copy of triangle {id} differs from the mesh"
                 ));
@@ -181,7 +181,7 @@ mod tests {
     use std::sync::Arc;
 
     fn built() -> (Grid, Arc<raybench_geom::TriangleMesh>) {
-        let mesh = raybench_scenes::generate("soup:triangles=500", 3)
+        let mesh = raybench_testkit::scenes::generate("soup:triangles=500", 3)
             .unwrap()
             .mesh;
         (
@@ -267,8 +267,8 @@ mod tests {
                 .contains("differs from the mesh")
         );
         let (mut grid, mesh) = built();
-        let (id, copy) = (grid.triangles[4].ids[0], grid.triangles[4].get(0));
-        grid.triangles[3].set(0, id, &copy);
+        let (id, copy) = (grid.triangles[4].ids[0], grid.triangles[4].lane(0));
+        grid.triangles[3].set_lane(0, id, &copy);
         assert!(grid.validate(&mesh).unwrap_err().contains("stored twice"));
     }
 

@@ -60,7 +60,7 @@ fn default_conforms_on_the_shared_scenes() {
 
 #[test]
 fn too_large_is_an_error_not_an_abort() {
-    let mesh = raybench_scenes::generate("soup:triangles=2000", 1)
+    let mesh = raybench_testkit::scenes::generate("soup:triangles=2000", 1)
         .unwrap()
         .mesh;
     let params = GridParams {

@@ -2,7 +2,7 @@
 //! "0 mismatches in n rays (95% upper bound 3/n = …)", never "100 %", always with the counts of
 //! every validation class next to it (reliability.md §3.2, step 4).
 
-use raybench_accel::compare::VerdictCounts;
+use raybench_accel::classify::VerdictCounts;
 
 /// "0 mismatches in n rays (95% upper bound 3/n = 2.4e-5)", or "k mismatches in n rays".
 ///

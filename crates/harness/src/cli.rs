@@ -4,7 +4,7 @@
 
 use crate::atomic::ensure_writable_dir;
 use crate::registry;
-use crate::run::{SceneRequest, check_requests, suite_requests};
+use crate::run::{SceneRequest, check_requests};
 use anyhow::{Context, Result};
 use clap::Args;
 use raybench_scenes::Workload;
@@ -95,7 +95,7 @@ impl Selection {
                 let suite = raybench_scenes::load_suite(&path)
                     .with_context(|| format!("suite '{name}'"))?;
                 let requests = if self.scenes.is_empty() {
-                    suite_requests(&path, &suite.scenes)
+                    suite.requests(&path)
                 } else {
                     specs(&self.scenes)
                 };

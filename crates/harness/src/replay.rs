@@ -5,7 +5,7 @@
 use crate::registry::{self, BuildContext};
 use crate::validate::verdict_name;
 use anyhow::{Context, Result, bail};
-use raybench_accel::compare::{Tolerance, classify, classify_occlusion};
+use raybench_accel::classify::{Tolerance, classify, classify_occlusion};
 use raybench_accel::{Accel, Hit};
 use raybench_geom::{DVec3, Ray, Triangle, TriangleMesh};
 use std::fmt::Write;

@@ -5,7 +5,7 @@
 //! ray and hit values are carried as hex bit patterns so a disputed ray can be replayed.
 
 use crate::env::Environment;
-use raybench_accel::compare::{Tolerance, VerdictCounts};
+use raybench_accel::classify::{Tolerance, VerdictCounts};
 use raybench_accel::{BuildStats, Counters, Hit, Memory, PointHit};
 use raybench_geom::{Ray, RemovedTriangles, Vec3};
 use serde::{Deserialize, Serialize};

@@ -17,12 +17,12 @@ use crate::validate::{
     Sides, count_differences, count_point_differences, validate, validate_points,
 };
 use anyhow::{Context, Result, bail};
-use raybench_accel::compare::Tolerance;
+use raybench_accel::classify::Tolerance;
 use raybench_accel::{Accel, PointHit, PreparedRays};
 use raybench_embree::{Device, EmbreeParams, fpu};
 use raybench_geom::{Ray, Vec3};
-use raybench_scenes::{Scene, SuiteScene, SurfaceHit, WhittedParams, Workload};
-use std::path::{Path, PathBuf};
+use raybench_scenes::{RayRecipe, Scene, SurfaceHit, WhittedParams, Workload};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Everything `raybench run` needs; the CLI fills it from flags and the suite manifest.
@@ -50,35 +50,7 @@ pub struct RunOptions {
     pub dump_hits: Option<PathBuf>,
 }
 
-/// A scene to load: by spec, or a suite file entry (with its `optional` flag).
-#[derive(Clone, Debug)]
-pub enum SceneRequest {
-    Spec(String),
-    File { path: PathBuf, optional: bool },
-}
-
-impl SceneRequest {
-    pub(crate) fn label(&self) -> String {
-        match self {
-            SceneRequest::Spec(s) => s.clone(),
-            SceneRequest::File { path, .. } => path.display().to_string(),
-        }
-    }
-
-    /// The name the report uses for this scene: the spec as written (`teapot-in-stadium:view=
-    /// stadium`), or an OBJ file's name (`teapot.obj`), so a generated teapot and the teapot
-    /// file, or two views of one generator, never share a name.
-    fn report_name(&self) -> String {
-        let file_name = |p: &Path| p.file_name().map(|n| n.to_string_lossy().into_owned());
-        match self {
-            SceneRequest::Spec(s) if s.to_ascii_lowercase().ends_with(".obj") => {
-                file_name(Path::new(s)).unwrap_or_else(|| s.clone())
-            }
-            SceneRequest::Spec(s) => s.trim().to_string(),
-            SceneRequest::File { path, .. } => file_name(path).unwrap_or_else(|| self.label()),
-        }
-    }
-}
+pub use raybench_scenes::SceneRequest;
 
 /// `name`, or `name #2`, `name #3`, … if the run already has a scene of that name.
 fn unique_name(name: String, used: &mut std::collections::HashSet<String>) -> String {
@@ -94,21 +66,6 @@ fn unique_name(name: String, used: &mut std::collections::HashSet<String>) -> St
         .expect("some suffix is free");
     used.insert(unique.clone());
     unique
-}
-
-/// The scenes of a suite, resolved relative to the manifest's directory.
-pub fn suite_requests(manifest: &Path, scenes: &[SuiteScene]) -> Vec<SceneRequest> {
-    let base = manifest.parent().unwrap_or(Path::new("."));
-    scenes
-        .iter()
-        .map(|s| match s {
-            SuiteScene::Generated(spec) => SceneRequest::Spec(spec.clone()),
-            SuiteScene::File { obj, optional } => SceneRequest::File {
-                path: base.join(obj),
-                optional: *optional,
-            },
-        })
-        .collect()
 }
 
 /// Live progress on a terminal; one plain line per step on stderr otherwise (CI logs).
@@ -244,29 +201,14 @@ pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 /// a report or dump is written, instead of after the scenes listed before it were measured.
 pub fn check_requests(requests: &[SceneRequest]) -> Result<()> {
     for request in requests {
-        match request {
-            SceneRequest::Spec(spec) if is_obj_path(spec) => check_file_exists(Path::new(spec))?,
-            SceneRequest::Spec(spec) => {
-                raybench_scenes::check_spec(spec).with_context(|| format!("scene '{spec}'"))?
+        request.check().with_context(|| match request {
+            SceneRequest::Spec(spec) if !spec.to_ascii_lowercase().ends_with(".obj") => {
+                format!("scene '{spec}'")
             }
-            SceneRequest::File { path, optional } => {
-                if !*optional {
-                    check_file_exists(path)?;
-                }
-            }
-        }
+            _ => "scene file".to_string(),
+        })?;
     }
     Ok(())
-}
-
-fn is_obj_path(spec: &str) -> bool {
-    spec.to_ascii_lowercase().ends_with(".obj")
-}
-
-fn check_file_exists(path: &Path) -> Result<()> {
-    std::fs::metadata(path)
-        .map(|_| ())
-        .with_context(|| format!("scene file {}", path.display()))
 }
 
 /// Runs everything and returns the report (not yet written). With `dump_hits`, every
@@ -369,16 +311,7 @@ pub(crate) struct LoadedScene {
 
 fn load(request: &SceneRequest, seed: u64) -> Result<Option<LoadedScene>> {
     let start = Instant::now();
-    let scene = match request {
-        SceneRequest::Spec(spec) => raybench_scenes::resolve(spec, seed)?,
-        SceneRequest::File { path, optional } => {
-            if *optional && !path.exists() {
-                return Ok(None);
-            }
-            raybench_scenes::load_obj(path)?
-        }
-    };
-    Ok(Some(LoadedScene {
+    Ok(request.load(seed)?.map(|scene| LoadedScene {
         scene,
         load_ms: start.elapsed().as_secs_f64() * 1e3,
     }))
@@ -587,8 +520,8 @@ impl<'a> SceneRun<'a> {
     }
 }
 
-/// The ray workloads of a scene: rays generated with the reference (secondary rays start at
-/// its primary hits) and its answers.
+/// The ray workloads of a scene: rays made by the one recipe ([`RayRecipe`]: secondary rays
+/// start at the reference's primary hits) and the reference's answers.
 fn ray_workloads(
     s: &Scene,
     reference: &dyn Accel,
@@ -597,28 +530,14 @@ fn ray_workloads(
     seed: u64,
     threads: usize,
 ) -> Result<Vec<PreparedWorkload>> {
-    let bounds = s.mesh.bounds();
-    let (primary, w, h) = raybench_scenes::primary_rays(&s.view, &bounds, ray_count);
-    let surface: Vec<Option<SurfaceHit>> =
-        primary.iter().map(|r| surface_hit(reference, r)).collect();
+    let trace = |r: &Ray| surface_hit(reference, r);
+    let recipe = RayRecipe::new(s, ray_count, seed, &trace);
     let mut prepared = Vec::new();
     for &wl in workloads {
-        let (rays, size) = match wl {
-            Workload::Primary => (primary.clone(), Some((w, h))),
-            Workload::Random => (raybench_scenes::random_rays(&bounds, ray_count, seed), None),
-            Workload::Shadow => (
-                raybench_scenes::shadow_rays(&s.mesh, s.view.light, &primary, &surface),
-                None,
-            ),
-            Workload::Diffuse => (
-                raybench_scenes::diffuse_rays(&s.mesh, &primary, &surface, seed),
-                None,
-            ),
-            Workload::Whitted => (whitted_rays(s, reference, &primary, &surface), None),
-            Workload::PointsNear | Workload::PointsVolume => {
-                bail!("{wl} is a closest-point workload, not a ray workload")
-            }
+        let Some(rays) = recipe.rays(wl) else {
+            bail!("{wl} is a closest-point workload, not a ray workload")
         };
+        let size = (wl == Workload::Primary).then(|| recipe.image_size());
         check_rays(wl, &rays)?;
         let reference_answers = reference_answers(reference, &rays, wl.any_hit(), threads)?;
         prepared.push(PreparedWorkload {
@@ -728,32 +647,6 @@ pub(crate) fn points_not_dumped(dumping: bool, workloads: &[Workload]) -> Option
 /// Knobs of the recursive `whitted` workload, written into the report's run settings.
 pub fn whitted_params() -> WhittedParams {
     WhittedParams::default()
-}
-
-/// Every generation of Whitted's recursion below the primary rays, traced with the reference so
-/// each structure later traces the identical set.
-fn whitted_rays(
-    scene: &Scene,
-    reference: &dyn Accel,
-    primary: &[Ray],
-    primary_hits: &[Option<SurfaceHit>],
-) -> Vec<Ray> {
-    let params = whitted_params();
-    let mut all = Vec::new();
-    let mut parents = primary.to_vec();
-    let mut weights = vec![1.0; primary.len()];
-    let mut hits = primary_hits.to_vec();
-    for depth in 1..=params.max_depth {
-        let (children, child_weights) =
-            raybench_scenes::whitted_children(scene, &parents, &weights, &hits, &params);
-        all.extend_from_slice(&children);
-        if depth == params.max_depth || children.is_empty() {
-            break;
-        }
-        hits = children.iter().map(|r| surface_hit(reference, r)).collect();
-        (parents, weights) = (children, child_weights);
-    }
-    all
 }
 
 fn surface_hit(accel: &dyn Accel, ray: &Ray) -> Option<SurfaceHit> {

@@ -3,7 +3,7 @@
 
 use crate::agreement::{agreement_sentence_of, class_counts};
 use crate::report::{Report, is_point_workload};
-use raybench_accel::compare::VerdictCounts;
+use raybench_accel::classify::VerdictCounts;
 use std::fmt::Write;
 
 fn ratio(r: Option<f64>) -> String {

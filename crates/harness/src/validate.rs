@@ -1,10 +1,10 @@
 //! Checks a structure's answers against the reference's, ray by ray (or query point by query
-//! point), with the validation classes of `raybench_accel::compare` (and `compare_points`).
+//! point), with the validation classes of `raybench_accel::classify` (and `classify_points`).
 
 use crate::measure::Answers;
 use crate::report::{DisputedPoint, DisputedRay, Validation};
-use raybench_accel::compare::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
-use raybench_accel::compare_points::{classify_point, point_tolerance};
+use raybench_accel::classify::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
+use raybench_accel::classify_points::{classify_point, point_tolerance};
 use raybench_accel::{Accel, PointHit};
 use raybench_geom::{Ray, TriangleMesh, Vec3};
 
@@ -97,7 +97,7 @@ pub fn verdict_name(v: Verdict) -> &'static str {
     }
 }
 
-/// Classifies every closest-point answer against the reference's (`compare_points`: the
+/// Classifies every closest-point answer against the reference's (`classify_points`: the
 /// tolerance scales with the magnitude of the scene and the point); the first mismatches are
 /// kept with the point's bits.
 pub fn validate_points(

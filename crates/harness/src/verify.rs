@@ -1,7 +1,7 @@
 //! `raybench verify`: are the answers right? Every structure × scene × workload is checked
 //! against three references — `embree-medium` (Embree's default, fast mode), `embree-robust`
 //! (Embree's robust mode) and `bruteforce` (every triangle, Möller–Trumbore) — and every
-//! disagreement goes through the f64 arbiter of `raybench_accel::compare`, which decides
+//! disagreement goes through the f64 arbiter of `raybench_accel::classify`, which decides
 //! between the explained classes (`tie`, `boundary`, `edge_ambiguous`) and `mismatch`.
 //!
 //! Nothing is timed. Each structure runs its timed path (the prepared batch path `run` times,
@@ -15,7 +15,7 @@
 //!
 //! The workloads are the ones `run` makes (secondary rays start at `embree-medium`'s hits).
 //! Closest-point workloads (`points-near`, `points-volume`) are checked the same way, with the
-//! point classes of `raybench_accel::compare_points` and the same brute-force budget (one
+//! point classes of `raybench_accel::classify_points` and the same brute-force budget (one
 //! point–triangle test per triangle per query). `--dump-hits` covers ray workloads only.
 
 use crate::agreement::{agreement_sentence, class_counts};
@@ -32,7 +32,7 @@ use crate::validate::{
     Sides, count_differences, count_point_differences, validate, validate_points,
 };
 use anyhow::{Context, Result, ensure};
-use raybench_accel::compare::{Tolerance, VerdictCounts};
+use raybench_accel::classify::{Tolerance, VerdictCounts};
 use raybench_accel::{Accel, PointHit};
 use raybench_geom::{Ray, TriangleMesh};
 use raybench_scenes::Workload;

@@ -25,7 +25,7 @@ mod validate;
 pub use node::{MAX_DEPTH, Node};
 
 use build::Selection;
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount, PointHit};
+use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, Walk};
 use raybench_geom::{Aabb, MollerTriangle, Ray, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -219,50 +219,7 @@ impl Accel for KdTree {
         &self.name
     }
 
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        if self.params.mailbox {
-            self.trace::<false, true, _>(ray, &mut NoCount)
-        } else {
-            self.trace::<false, false, _>(ray, &mut NoCount)
-        }
-    }
-
-    fn occluded(&self, ray: &Ray) -> bool {
-        if self.params.mailbox {
-            self.trace::<true, true, _>(ray, &mut NoCount).is_some()
-        } else {
-            self.trace::<true, false, _>(ray, &mut NoCount).is_some()
-        }
-    }
-
-    fn intersect_counted(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        if self.params.mailbox {
-            self.trace::<false, true, _>(ray, c)
-        } else {
-            self.trace::<false, false, _>(ray, c)
-        }
-    }
-
-    fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
-        if self.params.mailbox {
-            self.trace::<true, true, _>(ray, c).is_some()
-        } else {
-            self.trace::<true, false, _>(ray, c).is_some()
-        }
-    }
-
-    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
-        self.closest(p, max_radius, &mut NoCount)
-    }
-
-    fn closest_point_counted(
-        &self,
-        p: Vec3,
-        max_radius: f32,
-        c: &mut Counters,
-    ) -> Option<PointHit> {
-        self.closest(p, max_radius, c)
-    }
+    raybench_accel::walk_queries!();
 
     fn build_stats(&self) -> BuildStats {
         self.stats.clone()
@@ -312,5 +269,19 @@ impl KdTree {
             mesh: mesh.clone(),
             zero_area: None,
         })
+    }
+}
+
+impl Walk for KdTree {
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        if self.params.mailbox {
+            self.trace::<ANY_HIT, true, C>(ray, c)
+        } else {
+            self.trace::<ANY_HIT, false, C>(ray, c)
+        }
+    }
+
+    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
+        self.closest(p, max_radius, c)
     }
 }

@@ -281,7 +281,7 @@ mod tests {
     use std::sync::Arc;
 
     fn built(params: KdParams) -> (KdTree, Arc<raybench_geom::TriangleMesh>) {
-        let mesh = raybench_scenes::generate("soup:triangles=500", 3)
+        let mesh = raybench_testkit::scenes::generate("soup:triangles=500", 3)
             .unwrap()
             .mesh;
         (KdTree::build(mesh.clone(), &params).unwrap(), mesh)

@@ -116,7 +116,7 @@ fn point_queries_conform_on_the_shared_scenes() {
 #[test]
 fn too_large_is_an_error_not_an_abort() {
     use raybench_accel::{Accel, BuildError};
-    let mesh = raybench_scenes::generate("soup:triangles=2000", 1)
+    let mesh = raybench_testkit::scenes::generate("soup:triangles=2000", 1)
         .expect("generates")
         .mesh;
     let tiny = KdParams {

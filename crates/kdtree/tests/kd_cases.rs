@@ -5,7 +5,7 @@
 use raybench_accel::{Accel, BruteForce, Counters};
 use raybench_geom::{Aabb, Ray, Triangle, TriangleMesh, Vec3};
 use raybench_kdtree::{KdParams, KdTree};
-use raybench_testkit::{Case, check_case, random_rays_in, seeded_rng};
+use raybench_testkit::{Case, check_case, random_rays_in};
 use std::sync::Arc;
 
 const SEED: u64 = 0x5eed_0d05;
@@ -26,8 +26,8 @@ fn check(case: &Case) {
 /// `t_split = 0 × inf = NaN`, so both children must be walked over the whole interval.
 fn rays_in_split_planes(kd: &KdTree, n: usize, seed: u64) -> Vec<Ray> {
     let b = kd.bounds().enlarged(0.05);
-    let mut rng = seeded_rng(seed);
-    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
+    let mut rng = raybench_geom::SplitMix64::new(seed);
+    let mut f = move || rng.unit();
     let splits: Vec<(usize, f32)> = kd
         .nodes()
         .iter()
@@ -63,7 +63,7 @@ fn triangles_and_rays_in_split_planes() {
         "city:triangles=3000",
         "plane:quads=16,tilt_deg=0",
     ] {
-        let mesh = raybench_scenes::generate(spec, SEED).unwrap().mesh;
+        let mesh = raybench_testkit::scenes::generate(spec, SEED).unwrap().mesh;
         for p in both_variants() {
             let kd = KdTree::build(mesh.clone(), &p).unwrap();
             let mut rays = rays_in_split_planes(&kd, 3000, SEED);
@@ -84,8 +84,8 @@ fn triangles_and_rays_in_split_planes() {
 
 #[test]
 fn a_huge_triangle_over_small_ones_stays_bounded() {
-    let mut rng = seeded_rng(SEED);
-    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
+    let mut rng = raybench_geom::SplitMix64::new(SEED);
+    let mut f = move || rng.unit();
     let mut tris: Vec<Triangle> = (0..2000)
         .map(|_| {
             let c = Vec3::new(f(), f(), f());
@@ -124,7 +124,7 @@ fn a_huge_triangle_over_small_ones_stays_bounded() {
 #[test]
 fn the_reference_budget_caps_duplication() {
     // 300 long thin triangles crossing each other: every split duplicates many of them.
-    let mesh = raybench_scenes::generate("hair:triangles=300,length=1", SEED)
+    let mesh = raybench_testkit::scenes::generate("hair:triangles=300,length=1", SEED)
         .unwrap()
         .mesh;
     let p = KdParams {
@@ -141,7 +141,7 @@ fn the_reference_budget_caps_duplication() {
 
 #[test]
 fn parallel_and_sequential_builds_make_the_same_tree() {
-    let mesh = raybench_scenes::generate("sphere:triangles=40000", SEED)
+    let mesh = raybench_testkit::scenes::generate("sphere:triangles=40000", SEED)
         .unwrap()
         .mesh;
     for p in both_variants() {
@@ -166,7 +166,7 @@ fn parallel_and_sequential_builds_make_the_same_tree() {
 
 #[test]
 fn counters_show_early_exit_and_mailbox_skips() {
-    let mesh = raybench_scenes::generate("sphere:triangles=20000", SEED)
+    let mesh = raybench_testkit::scenes::generate("sphere:triangles=20000", SEED)
         .unwrap()
         .mesh;
     let kd = KdTree::build(mesh.clone(), &KdParams::sah()).unwrap();
@@ -218,7 +218,7 @@ fn counters_show_early_exit_and_mailbox_skips() {
 #[test]
 fn mailbox_skips_happen_on_duplicated_references() {
     // Long needles crossing many cells: the same triangle is met again in later leaves.
-    let mesh = raybench_scenes::generate("hair:triangles=2000", SEED)
+    let mesh = raybench_testkit::scenes::generate("hair:triangles=2000", SEED)
         .unwrap()
         .mesh;
     let kd = KdTree::build(mesh.clone(), &KdParams::sah()).unwrap();

@@ -6,14 +6,15 @@ use raybench_accel::{Accel, Counters};
 use raybench_geom::{Aabb, Triangle, TriangleMesh, Vec3};
 use raybench_kdtree::{KdParams, KdTree};
 use raybench_testkit::points::{check_points, points_in_box, points_near_surface};
-use raybench_testkit::seeded_rng;
 use std::sync::Arc;
 
 const SEED: u64 = 0x5eed_7d01;
 
 fn soup(n: usize) -> Arc<TriangleMesh> {
     let spec = format!("soup:triangles={n}");
-    raybench_scenes::generate(&spec, SEED).unwrap().mesh
+    raybench_testkit::scenes::generate(&spec, SEED)
+        .unwrap()
+        .mesh
 }
 
 fn near_points(mesh: &TriangleMesh, n: usize) -> Vec<Vec3> {
@@ -34,7 +35,7 @@ fn work(kd: &KdTree, points: &[Vec3], radius: f32) -> Counters {
 #[test]
 fn points_in_split_planes() {
     for spec in ["coplanar:triangles=3000", "city:triangles=3000"] {
-        let mesh = raybench_scenes::generate(spec, SEED).unwrap().mesh;
+        let mesh = raybench_testkit::scenes::generate(spec, SEED).unwrap().mesh;
         for params in [KdParams::sah(), KdParams::median()] {
             let kd = KdTree::build(mesh.clone(), &params).unwrap();
             kd.validate(&mesh).unwrap();
@@ -134,8 +135,8 @@ fn the_radius_prunes_from_the_start() {
 fn zero_area_triangles_are_found_through_the_side_tree() {
     let mut tris: Vec<Triangle> = soup(500).triangles().collect();
     let hittable = tris.len() as u32;
-    let mut rng = seeded_rng(SEED);
-    let mut f = move || (rand_core::Rng::next_u32(&mut rng) >> 8) as f32 / (1u32 << 24) as f32;
+    let mut rng = raybench_geom::SplitMix64::new(SEED);
+    let mut f = move || rng.unit();
     let mut probes = Vec::new();
     for i in 0..300 {
         // Outside the soup's unit box, so nothing else is nearer.

@@ -25,7 +25,7 @@ mod validate;
 
 pub use node::{MAX_DEPTH_LIMIT, Node};
 
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, NoCount, PointHit};
+use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, Walk};
 use raybench_geom::{Aabb, MollerTriangle, Ray, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -145,34 +145,7 @@ impl Accel for Octree {
         &self.name
     }
 
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.trace::<false, _>(ray, &mut NoCount)
-    }
-
-    fn occluded(&self, ray: &Ray) -> bool {
-        self.trace::<true, _>(ray, &mut NoCount).is_some()
-    }
-
-    fn intersect_counted(&self, ray: &Ray, c: &mut Counters) -> Option<Hit> {
-        self.trace::<false, _>(ray, c)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, c: &mut Counters) -> bool {
-        self.trace::<true, _>(ray, c).is_some()
-    }
-
-    fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
-        self.closest(p, max_radius, &mut NoCount)
-    }
-
-    fn closest_point_counted(
-        &self,
-        p: Vec3,
-        max_radius: f32,
-        c: &mut Counters,
-    ) -> Option<PointHit> {
-        self.closest(p, max_radius, c)
-    }
+    raybench_accel::walk_queries!();
 
     fn build_stats(&self) -> BuildStats {
         self.stats.clone()
@@ -184,5 +157,15 @@ impl Accel for Octree {
             indices: std::mem::size_of_val(self.refs.as_slice()) as u64,
             primitives: std::mem::size_of_val(self.triangles.as_slice()) as u64,
         }
+    }
+}
+
+impl Walk for Octree {
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        self.trace::<ANY_HIT, C>(ray, c)
+    }
+
+    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
+        self.closest(p, max_radius, c)
     }
 }

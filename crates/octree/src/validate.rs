@@ -197,7 +197,7 @@ mod tests {
     use std::sync::Arc;
 
     fn built() -> (Octree, Arc<raybench_geom::TriangleMesh>) {
-        let mesh = raybench_scenes::generate("soup:triangles=500", 3)
+        let mesh = raybench_testkit::scenes::generate("soup:triangles=500", 3)
             .unwrap()
             .mesh;
         (

@@ -54,7 +54,7 @@ fn default_conforms_on_the_shared_scenes() {
 
 #[test]
 fn too_large_is_an_error_not_an_abort() {
-    let mesh = raybench_scenes::generate("soup:triangles=2000", 1)
+    let mesh = raybench_testkit::scenes::generate("soup:triangles=2000", 1)
         .unwrap()
         .mesh;
     for limit in [1024, 2000 * 72 + 4096] {
@@ -84,7 +84,7 @@ fn degenerate_inputs_stop_early() {
         ("one-centroid:triangles=1000", 1.0),
         ("fan:triangles=5000", 1000.0),
     ] {
-        let mesh = raybench_scenes::generate(spec, 1).unwrap().mesh;
+        let mesh = raybench_testkit::scenes::generate(spec, 1).unwrap().mesh;
         let tree = Octree::build(mesh.clone(), &OctreeParams::default()).unwrap();
         tree.validate(&mesh).unwrap();
         let s = tree.build_stats();

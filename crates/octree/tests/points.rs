@@ -12,7 +12,7 @@ use std::sync::Arc;
 const SEED: u64 = 0x5eed_7801;
 
 fn soup() -> Arc<TriangleMesh> {
-    raybench_scenes::generate("soup:triangles=3000", SEED)
+    raybench_testkit::scenes::generate("soup:triangles=3000", SEED)
         .unwrap()
         .mesh
 }

@@ -3,9 +3,12 @@
 //! * Scenes: procedural generators ([`generate`], listed by [`generators`]) and Wavefront OBJ
 //!   files ([`load_obj`]), both behind [`resolve`]. OBJ files are untrusted input: every problem
 //!   is a [`SceneError`] naming the file (and line), never a panic.
-//! * Workloads ([`Workload`]): primary, random, shadow and diffuse rays. Each is a pure function
-//!   of its inputs and a seed, using `rand_pcg` streams that are independent per purpose.
-//! * Suites ([`Suite`]): JSON manifests in the repository's `bench-scenes/`.
+//! * Workloads ([`Workload`]): primary, random, shadow, diffuse and Whitted rays, and
+//!   closest-point queries. Each is a pure function of its inputs and a seed, using `rand_pcg`
+//!   streams that are independent per purpose; [`RayRecipe`] makes a scene's ray workloads
+//!   from a reference's primary hits, the one way every caller makes them.
+//! * Suites ([`Suite`]): JSON manifests in the repository's `bench-scenes/`, and
+//!   [`SceneRequest`], the one resolver of the scenes a run asks for.
 #![forbid(unsafe_code)]
 
 mod error;
@@ -13,6 +16,8 @@ mod generate;
 mod material;
 mod obj;
 pub mod points;
+mod recipe;
+mod request;
 mod rng;
 mod suite;
 mod view;
@@ -25,7 +30,9 @@ pub use generate::{
 pub use material::Material;
 pub use obj::export::{in_file_order, write_obj};
 pub use obj::{load_obj, load_obj_bytes};
-pub use suite::{Suite, SuiteScene, list_suites, load_suite, resolve_suite_scenes, suites_dir};
+pub use recipe::{RayRecipe, TraceFn};
+pub use request::SceneRequest;
+pub use suite::{Suite, SuiteScene, list_suites, load_suite, suites_dir};
 pub use view::{Camera, View};
 pub use workload::{
     SHADOW_T_MAX, SurfaceHit, SurfacePoint, WhittedParams, Workload, diffuse_rays, primary_rays,
@@ -112,7 +119,7 @@ pub fn resolve(spec: &str, seed: u64) -> Result<Scene, SceneError> {
     }
 }
 
-fn is_obj_path(spec: &str) -> bool {
+pub(crate) fn is_obj_path(spec: &str) -> bool {
     spec.len() >= 4
         && spec.is_char_boundary(spec.len() - 4)
         && spec[spec.len() - 4..].eq_ignore_ascii_case(".obj")

@@ -8,6 +8,7 @@
 use rand_core::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use raybench_geom::Vec3;
+use raybench_geom::rng::{GOLDEN_GAMMA, mix64};
 use std::f32::consts::TAU;
 
 /// Stream tags: ASCII names, so a seed dump is self-explanatory.
@@ -23,14 +24,7 @@ pub(crate) fn stream(seed: u64, purpose: u64) -> Pcg64Mcg {
 /// how many numbers earlier items drew. The index is spread by a SplitMix64 finaliser so that
 /// neighbouring indices do not give neighbouring seeds.
 pub(crate) fn item_stream(seed: u64, purpose: u64, index: u64) -> Pcg64Mcg {
-    Pcg64Mcg::seed_from_u64(seed ^ purpose ^ splitmix64(index))
-}
-
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+    Pcg64Mcg::seed_from_u64(seed ^ purpose ^ mix64(index.wrapping_add(GOLDEN_GAMMA)))
 }
 
 /// Uniform in `[0, 1)`: the largest value is `1 - 2^-24`.

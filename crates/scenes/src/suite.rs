@@ -1,7 +1,7 @@
 //! Suite manifests: JSON files in the repository's `bench-scenes/` naming scenes, structures,
 //! workloads and the ray and point counts of a benchmark run.
 
-use crate::{Scene, SceneError, Workload, generate, load_obj};
+use crate::{SceneError, Workload};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -99,44 +99,4 @@ pub fn list_suites() -> Result<Vec<(PathBuf, Suite)>, SceneError> {
         .into_iter()
         .map(|p| load_suite(&p).map(|s| (p, s)))
         .collect()
-}
-
-/// Makes every scene of a suite, in manifest order.
-///
-/// Returns one `Result` per scene that was attempted (so the caller can report each failure
-/// and decide whether to go on), and notes for optional files that were skipped because they
-/// are absent, e.g. `"skipped ../../shared/scenes/x.obj (optional): /abs/x.obj does not exist"`.
-/// A present but broken file is an `Err`, never a note. File paths are relative to the
-/// directory of `suite_path`.
-pub fn resolve_suite_scenes(
-    suite_path: &Path,
-    suite: &Suite,
-    seed: u64,
-) -> (Vec<Result<Scene, SceneError>>, Vec<String>) {
-    let base = suite_path.parent().unwrap_or(Path::new("."));
-    let mut scenes = Vec::new();
-    let mut notes = Vec::new();
-    for entry in &suite.scenes {
-        match entry {
-            SuiteScene::Generated(spec) => scenes.push(generate(spec, seed)),
-            SuiteScene::File { obj, optional } => {
-                let path = base.join(obj);
-                if *optional && is_absent(&path) {
-                    notes.push(format!(
-                        "skipped {obj} (optional): {} does not exist",
-                        path.display()
-                    ));
-                } else {
-                    scenes.push(load_obj(&path));
-                }
-            }
-        }
-    }
-    (scenes, notes)
-}
-
-/// Absent means "not found" (including a missing parent folder); a file that exists but cannot
-/// be read is not absent, and its load error is reported.
-fn is_absent(path: &Path) -> bool {
-    matches!(std::fs::metadata(path), Err(e) if e.kind() == std::io::ErrorKind::NotFound)
 }

@@ -2,8 +2,7 @@ mod common;
 
 use common::Fixtures;
 use raybench_scenes::{
-    SceneError, Suite, SuiteScene, Workload, generate, list_suites, load_suite,
-    resolve_suite_scenes, suites_dir,
+    SceneError, Suite, SuiteScene, Workload, generate, list_suites, load_suite, suites_dir,
 };
 
 fn repository_suite(name: &str) -> (std::path::PathBuf, Suite) {
@@ -133,23 +132,32 @@ fn default_lists_every_shared_scene_as_optional() {
 #[test]
 fn ci_suite_resolves_with_the_bunny_or_a_note() {
     let (path, suite) = repository_suite("ci.json");
-    let (scenes, notes) = resolve_suite_scenes(&path, &suite, 0);
-    let names: Vec<String> = scenes
+    let requests = suite.requests(&path);
+    assert_eq!(requests.len(), suite.scenes.len());
+    let loaded: Vec<Option<String>> = requests
         .iter()
-        .map(|s| s.as_ref().unwrap().name.clone())
+        .map(|r| r.load(0).unwrap().map(|s| s.name))
         .collect();
     let generated = suite
         .scenes
         .iter()
         .filter(|s| matches!(s, SuiteScene::Generated(_)))
         .count();
-    assert_eq!(names[..3], ["sphere", "soup", "plane"]);
-    match names.get(generated) {
+    assert_eq!(
+        loaded[..3],
+        [
+            Some("sphere".into()),
+            Some("soup".into()),
+            Some("plane".into())
+        ]
+    );
+    assert!(loaded[..generated].iter().all(Option::is_some));
+    match &loaded[generated] {
         Some(bunny) => assert_eq!(bunny, "stanford-bunny"),
-        None => {
-            eprintln!("NOTE: the bunny was not loaded: {notes:?}");
-            assert_eq!(notes.len(), 1);
-        }
+        None => eprintln!(
+            "NOTE: the bunny was not loaded: {} is absent",
+            requests[generated].label()
+        ),
     }
 }
 
@@ -170,20 +178,20 @@ fn absent_optional_file_is_a_note_but_broken_or_required_files_are_errors() {
         {"obj": "missing.obj"}]"#;
     let path = fx.write("t.json", manifest(scenes));
     let suite = load_suite(&path).unwrap();
-    let (scenes, notes) = resolve_suite_scenes(&path, &suite, 0);
-    assert_eq!(scenes.len(), 3);
-    assert!(scenes[0].is_ok());
-    let broken = scenes[1].as_ref().unwrap_err().to_string();
+    let requests = suite.requests(&path);
+    assert_eq!(requests.len(), 4);
+    assert!(matches!(requests[0].load(0), Ok(Some(_))));
+    assert!(requests[1].label().ends_with("nowhere/x.obj"));
+    assert!(matches!(requests[1].load(0), Ok(None)));
+    assert!(requests[1].check().is_ok());
+    let broken = requests[2].load(0).unwrap_err().to_string();
     assert!(
         broken.contains("broken.obj: line 2: vertex index 2 is out of range"),
         "{broken}"
     );
-    assert!(matches!(scenes[2], Err(SceneError::Io { .. })));
-    assert_eq!(notes.len(), 1);
-    assert!(
-        notes[0].starts_with("skipped nowhere/x.obj (optional): "),
-        "{notes:?}"
-    );
+    assert!(matches!(requests[3].load(0), Err(SceneError::Io { .. })));
+    let missing = requests[3].check().unwrap_err().to_string();
+    assert!(missing.contains("missing.obj"), "{missing}");
 }
 
 #[test]

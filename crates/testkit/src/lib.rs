@@ -10,21 +10,22 @@
 //! ```
 //!
 //! Every check compares the structure with [`BruteForce`] on named, seeded scenes and ray sets,
-//! classifying each ray with `raybench_accel::compare` and requiring zero mismatches; the
+//! classifying each ray with `raybench_accel::classify` and requiring zero mismatches; the
 //! structure's own `validate()` runs after every build; the counted walk must give the same
 //! answers as the timed walk; any-hit must agree with closest-hit. On failure the message names
 //! the case, the seed and the exact ray bits.
 #![forbid(unsafe_code)]
 
-pub mod bench;
 mod cases;
 pub mod points;
 mod rays;
 
 pub use cases::{Case, edge_cases, lattice_scene, seeded_cases};
+/// The scene generators, for structure crates' tests (which depend on testkit, not on scenes).
+pub use raybench_scenes as scenes;
 pub use rays::{centroid_rays, lattice_rays, random_rays_in, seeded_rng};
 
-use raybench_accel::compare::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
+use raybench_accel::classify::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
 use raybench_accel::{Accel, BruteForce, Counters};
 use raybench_geom::{Ray, TriangleMesh};
 use std::sync::Arc;

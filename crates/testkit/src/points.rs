@@ -32,8 +32,8 @@ use std::sync::Arc;
 pub const SEED_POINTS_NEAR: u64 = 0x5eed_7001;
 pub const SEED_POINTS_VOLUME: u64 = 0x5eed_7002;
 
-/// Tolerance in f32 ulps (see [`raybench_accel::compare_points::POINT_TOLERANCE_ULPS`]).
-pub const TOLERANCE_ULPS: f64 = raybench_accel::compare_points::POINT_TOLERANCE_ULPS;
+/// Tolerance in f32 ulps (see [`raybench_accel::classify_points::POINT_TOLERANCE_ULPS`]).
+pub const TOLERANCE_ULPS: f64 = raybench_accel::classify_points::POINT_TOLERANCE_ULPS;
 
 /// A mesh, the query points and the radii to ask them with.
 #[derive(Clone, Debug)]
@@ -182,9 +182,9 @@ pub fn exact_distance(p: Vec3, tri: &Triangle) -> f64 {
 }
 
 /// Absolute distance tolerance for queries at `p` on `mesh` (shared with the harness: see
-/// [`raybench_accel::compare_points::point_tolerance`]).
+/// [`raybench_accel::classify_points::point_tolerance`]).
 pub fn tolerance(mesh_bounds: &Aabb, p: Vec3) -> f64 {
-    raybench_accel::compare_points::point_tolerance(mesh_bounds, p)
+    raybench_accel::classify_points::point_tolerance(mesh_bounds, p)
 }
 
 /// The checks one answer must pass on its own, whatever brute force says.
@@ -227,7 +227,7 @@ fn check_answer(
 }
 
 /// Classifies `ours` against brute force's `expected` (see the module documentation; the
-/// rule itself is [`raybench_accel::compare_points::classify_point`], which the harness uses
+/// rule itself is [`raybench_accel::classify_points::classify_point`], which the harness uses
 /// against Embree).
 pub fn classify_point(
     mesh: &TriangleMesh,
@@ -237,8 +237,8 @@ pub fn classify_point(
     expected: Option<PointHit>,
     tol: f64,
 ) -> PointVerdict {
-    use raybench_accel::compare::Verdict;
-    match raybench_accel::compare_points::classify_point(mesh, p, radius, ours, expected, tol) {
+    use raybench_accel::classify::Verdict;
+    match raybench_accel::classify_points::classify_point(mesh, p, radius, ours, expected, tol) {
         Verdict::BothMiss => PointVerdict::BothNone,
         Verdict::Exact => PointVerdict::Exact,
         Verdict::WithinTolerance => PointVerdict::WithinTolerance,

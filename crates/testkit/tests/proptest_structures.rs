@@ -20,8 +20,8 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::FileFailurePersistence;
-use raybench_accel::compare::VerdictCounts;
-use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, WideParams};
+use raybench_accel::classify::VerdictCounts;
+use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, WideParams};
 use raybench_geom::{Aabb, Ray, Triangle, TriangleMesh, Vec3};
 use raybench_grid::{Grid, GridParams};
 use raybench_kdtree::{KdParams, KdTree};
@@ -291,7 +291,7 @@ const STRUCTURES: [(&str, Check); 12] = [
         check_case::<Bvh4>(c, &WideParams::for_width(4), &|a, m| a.validate(m))
     }),
     ("bvh8-binned", |c| {
-        check_case::<Bvh8>(c, &Bvh8Params::default(), &|a, m| a.validate(m))
+        check_case::<Bvh8>(c, &WideParams::default(), &|a, m| a.validate(m))
     }),
     ("kd-sah", |c| {
         check_case::<KdTree>(c, &KdParams::sah(), &|a, m| a.validate(m))

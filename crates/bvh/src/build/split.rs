@@ -494,22 +494,15 @@ fn partition(refs: &mut [PrimRef], mid: usize, goes_left: impl Fn(&PrimRef) -> b
 mod tests {
     use super::*;
     use crate::WideParams;
-    use raybench_geom::{Aabb, Vec3};
+    use raybench_geom::Aabb;
 
-    /// Boxes of `n` small triangles scattered in the unit cube, from a fixed seed (SplitMix64).
+    /// Boxes of `n` small triangles scattered in the unit cube, from a fixed seed.
     fn scattered(n: usize, seed: u64) -> Vec<Aabb> {
-        let mut state = seed;
-        let mut next = move || {
-            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = raybench_geom::SplitMix64::new(seed);
         (0..n)
             .map(|_| {
-                let lo = Vec3::new(next(), next(), next());
-                Aabb::new(lo, lo + Vec3::new(next(), next(), next()) * 0.05)
+                let lo = rng.unit_vec();
+                Aabb::new(lo, lo + rng.unit_vec() * 0.05)
             })
             .collect()
     }

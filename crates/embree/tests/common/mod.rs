@@ -1,52 +1,12 @@
-//! Seeded scenes and rays for the Embree tests. Self-contained on purpose: a tiny generator
-//! (SplitMix64) so the tests depend on no scene crate and every case replays from its seed.
+//! Seeded scenes and rays for the Embree tests, from the workspace's SplitMix64, so the tests
+//! depend on no scene crate and every case replays from its seed.
 #![allow(dead_code)] // each test binary uses a different part
 
 use raybench_embree::EmbreeParams;
 use raybench_geom::{Ray, Triangle, TriangleMesh, Vec3};
 use std::sync::Arc;
 
-/// SplitMix64 (Steele, Lea, Flood 2014): tiny, fast, well-distributed, deterministic.
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    pub fn new(seed: u64) -> SplitMix64 {
-        SplitMix64(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1): the top 24 bits, exactly representable in f32.
-    pub fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    pub fn point_in(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
-        Vec3::new(
-            self.range(lo.x, hi.x),
-            self.range(lo.y, hi.y),
-            self.range(lo.z, hi.z),
-        )
-    }
-
-    /// Uniform on the unit sphere (Archimedes: z uniform, angle uniform).
-    pub fn direction(&mut self) -> Vec3 {
-        let z = self.range(-1.0, 1.0);
-        let phi = self.range(0.0, std::f32::consts::TAU);
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-}
+pub use raybench_geom::SplitMix64;
 
 pub fn mesh_of(triangles: &[Triangle]) -> Arc<TriangleMesh> {
     let (mesh, removed) = TriangleMesh::from_triangles(triangles).unwrap();

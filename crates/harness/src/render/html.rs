@@ -147,7 +147,7 @@ fn validation_table(s: &mut String, report: &Report) {
          <th>mismatch</th><th>counted path differs</th></tr>\n",
     );
     for st in structure_names(report) {
-        let mut c = raybench_accel::compare::VerdictCounts::default();
+        let mut c = raybench_accel::classify::VerdictCounts::default();
         let mut differs = 0;
         for w in report
             .results

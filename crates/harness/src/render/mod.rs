@@ -332,7 +332,7 @@ fn timing_workload(report: &Report) -> Option<String> {
 type Curve = (&'static str, fn(f64) -> f64);
 
 /// How many rays of a validation class.
-type ClassCount = fn(&raybench_accel::compare::VerdictCounts) -> u64;
+type ClassCount = fn(&raybench_accel::classify::VerdictCounts) -> u64;
 
 /// The generator (or file) a scene name comes from: `teapot:triangles=4000` → `teapot`.
 fn family(scene: &str) -> &str {

@@ -17,6 +17,7 @@ use crate::{Camera, View};
 use rand_core::Rng;
 use rand_pcg::Pcg64Mcg;
 use raybench_geom::Vec3;
+use raybench_geom::rng::{GOLDEN_GAMMA, mix64};
 
 const TERRAIN_STREAM: u64 = u64::from_be_bytes(*b"gen-terr");
 
@@ -173,15 +174,13 @@ fn lerp(a: f64, b: f64, t: f64) -> f64 {
 }
 
 /// A value in [-1, 1) for lattice point `(i, j)`: the two coordinates are multiplied by
-/// different odd constants, combined with the key, and mixed by a 64-bit finaliser (the one of
-/// SplitMix64), whose top 53 bits make the value.
+/// different odd constants, combined with the key, and mixed by SplitMix64's finaliser, whose
+/// top 53 bits make the value.
 fn lattice_value(key: u64, i: i64, j: i64) -> f64 {
-    let mut h = key
-        ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        ^ (j as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
-    h = (h ^ (h >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    h = (h ^ (h >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    h ^= h >> 31;
+    let h = mix64(
+        key ^ (i as u64).wrapping_mul(GOLDEN_GAMMA)
+            ^ (j as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F),
+    );
     (h >> 11) as f64 * (2.0 / (1u64 << 53) as f64) - 1.0
 }
 

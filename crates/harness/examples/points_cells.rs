@@ -8,7 +8,7 @@
 //! counters for the work per query (per query: nodes, leaves, cells, point–triangle tests,
 //! mailbox skips).
 //!
-//! `cargo run --release -p raybench-grid --example points_cells -- [SCENE.obj] [points=100000]
+//! `cargo run --release -p raybench-harness --example points_cells -- [SCENE.obj] [points=100000]
 //!  [reps=5]` (default scene: ../shared/scenes/stanford-bunny.obj)
 
 use raybench_accel::{Accel, BuildError, Counters, build_dyn};

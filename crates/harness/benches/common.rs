@@ -1,5 +1,5 @@
-//! The criterion benches every structure crate runs, written once: building on the Stanford
-//! bunny and tracing 100k seeded random rays through it, per named variant.
+//! The criterion bench shape every family shares: building on the Stanford bunny and tracing
+//! 100k seeded random rays through it, per named variant.
 
 use criterion::{BenchmarkId, Criterion, Throughput};
 use raybench_accel::Accel;

@@ -5,11 +5,11 @@
 //! Mqueries/s over rounds and the median of the per-round ratio to Embree, plus nodes and
 //! point–triangle tests per query from one counted pass.
 //!
-//! `cargo run --release -p raybench-bvh --example points_bvh -- ../shared/scenes/stanford-bunny.obj 100000 7`
+//! `cargo run --release -p raybench-harness --example points_bvh -- ../shared/scenes/stanford-bunny.obj 100000 7`
 //! (scene, points per workload, rounds).
 
 use raybench_accel::{Accel, Counters, PointHit};
-use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
+use raybench_bvh::{Bvh, Bvh8, BvhParams, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Vec3;
 use raybench_scenes::points::PointWorkload;
@@ -81,7 +81,7 @@ fn main() {
     let structures: Vec<Box<dyn Accel>> = vec![
         Box::new(EmbreeScene::build(Arc::clone(&mesh), &embree).expect("builds")),
         Box::new(Bvh::build(Arc::clone(&mesh), &BvhParams::binned()).expect("builds")),
-        Box::new(Bvh8::build(Arc::clone(&mesh), &Bvh8Params::default()).expect("builds")),
+        Box::new(Bvh8::build(Arc::clone(&mesh), &WideParams::default()).expect("builds")),
     ];
     for workload in PointWorkload::ALL {
         let points = workload.generate(&mesh, n, SEED);

@@ -1,6 +1,6 @@
 //! Prints the SAH cost and build time of the sweep builder and of the binned builder at 8, 16,
 //! 32 and 64 bins on an OBJ file (how the `bins` default was chosen):
-//! `cargo run --release -p raybench-bvh --example sah -- FILE.obj`.
+//! `cargo run --release -p raybench-harness --example sah -- FILE.obj`.
 use raybench_accel::Accel;
 use raybench_bvh::{Bvh, BvhParams};
 use std::time::Instant;

@@ -4,7 +4,7 @@
 //! pass (the one least disturbed by other processes) and its ratio to Embree's best pass.
 //! Short passes and many rounds make an undisturbed pass likely.
 //!
-//! `cargo run --release -p raybench-bvh --example wide -- ../shared/scenes/stanford-bunny.obj 50000 20`
+//! `cargo run --release -p raybench-harness --example wide -- ../shared/scenes/stanford-bunny.obj 50000 20`
 //! (scene: an .obj path or a generator spec such as `hair`; rays per workload; rounds;
 //! optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round
 //! (valgrind runs no AVX-512, so there `bvh8` takes the AVX2-only loops).
@@ -19,10 +19,10 @@
 //! (embree-medium whenever it is kept).
 
 use raybench_accel::{Accel, PreparedRays};
-use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh8Params, BvhParams, NodeSimd, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, NodeSimd, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
-use raybench_scenes::SurfaceHit;
+use raybench_scenes::{RayRecipe, SurfaceHit, Workload};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -56,7 +56,6 @@ fn main() {
     // An .obj path, or a generator spec as the harness takes them (`hair`, `soup:triangles=5000`).
     let scene = raybench_scenes::resolve(&path, 1).expect("scene loads");
     let mesh = Arc::clone(&scene.mesh);
-    let bounds = mesh.bounds();
 
     let mut structures: Vec<(String, Box<dyn Accel>, f64)> = Vec::new();
     let mut add = |name: &str, build: &dyn Fn() -> Box<dyn Accel>| {
@@ -79,22 +78,22 @@ fn main() {
         Box::new(Bvh4::build(Arc::clone(&mesh), &WideParams::for_width(4)).expect("builds"))
     });
     add("bvh8", &|| {
-        Box::new(Bvh8::build(Arc::clone(&mesh), &Bvh8Params::default()).expect("builds"))
+        Box::new(Bvh8::build(Arc::clone(&mesh), &WideParams::default()).expect("builds"))
     });
     add("bvh8-packets", &|| {
-        let packets = Bvh8Params {
+        let packets = WideParams {
             coherent_packets: true,
-            ..Bvh8Params::default()
+            ..WideParams::default()
         };
         Box::new(Bvh8::build(Arc::clone(&mesh), &packets).expect("builds"))
     });
-    let sse = Bvh8Params {
+    let sse = WideParams {
         node_simd: NodeSimd::Sse,
-        ..Bvh8Params::default()
+        ..WideParams::default()
     };
-    let only_avx2 = Bvh8Params {
+    let only_avx2 = WideParams {
         node_simd: NodeSimd::Avx2,
-        ..Bvh8Params::default()
+        ..WideParams::default()
     };
     add("bvh8-avx2", &|| {
         Box::new(Bvh8::build(Arc::clone(&mesh), &only_avx2).expect("builds"))
@@ -110,27 +109,22 @@ fn main() {
             std::process::exit(2);
         }
     }
-    let primary = raybench_scenes::primary_rays(&scene.view, &bounds, n).0;
     let reference = &structures[0].1;
-    let hits: Vec<Option<SurfaceHit>> = primary
-        .iter()
-        .map(|r| {
-            reference.intersect(r).map(|h| SurfaceHit {
-                prim: h.prim,
-                u: h.u,
-                v: h.v,
-            })
+    let trace = |r: &Ray| {
+        reference.intersect(r).map(|h| SurfaceHit {
+            prim: h.prim,
+            u: h.u,
+            v: h.v,
         })
-        .collect();
-    let workloads = [
-        ("primary", primary.clone(), false),
-        ("random", raybench_scenes::random_rays(&bounds, n, 1), false),
+    };
+    let recipe = RayRecipe::new(&scene, n, 1, &trace);
+    let workloads = [Workload::Primary, Workload::Random, Workload::Shadow].map(|w| {
         (
-            "shadow",
-            raybench_scenes::shadow_rays(&mesh, scene.view.light, &primary, &hits),
-            true,
-        ),
-    ];
+            w.name(),
+            recipe.rays(w).expect("a ray workload"),
+            w.any_hit(),
+        )
+    });
     for (name, rays, any_hit) in &workloads {
         if only.as_deref().is_some_and(|o| o != *name) {
             continue;

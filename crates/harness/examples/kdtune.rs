@@ -4,7 +4,7 @@
 //! same-run ratio: this machine is shared and noisy). Used to choose the defaults documented on
 //! `KdParams::sah` and `MAILBOX_SLOTS`.
 //!
-//! `cargo run --release -p raybench-kdtree --example kdtune -- SCENE [builder=median]
+//! `cargo run --release -p raybench-harness --example kdtune -- SCENE [builder=median]
 //!  [kt=1] [ki=1.5] [bonus=0.8] [depth=N] [leaf=0] [mailbox=true] [rays=100000] [reps=3]`
 
 use raybench_accel::{Accel, Counters};

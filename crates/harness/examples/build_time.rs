@@ -9,17 +9,17 @@
 //! harness does (`Workers::start`). The device is created before the first timed build and
 //! kept alive, so no timed build pays for Embree's thread start-up.
 //!
-//! `bvh-bin4` is the binary tree the 8-wide BVH is collapsed from (`Bvh8Params::default()`'s
+//! `bvh-bin4` is the binary tree the 8-wide BVH is collapsed from (`WideParams::default()`'s
 //! `binary` knobs) built and flattened on its own: the difference to `bvh8` is the collapse and
 //! the triangle packets. The digests identify the trees (nodes and triangle order), to check
 //! that a builder change keeps them identical, and with any thread count.
 //!
-//! `cargo run --release -p raybench-bvh --example build_time -- ../shared/scenes/stanford-bunny.obj 2 21`
+//! `cargo run --release -p raybench-harness --example build_time -- ../shared/scenes/stanford-bunny.obj 2 21`
 //! (scene: an .obj path or a generator spec such as `city`; threads; rounds; optionally a label
 //! filter). Under `valgrind --tool=callgrind` use 1 round.
 
 use raybench_accel::Accel;
-use raybench_bvh::{Bvh, Bvh8, Bvh8Params, BvhParams};
+use raybench_bvh::{Bvh, Bvh8, BvhParams, WideParams};
 use raybench_embree::{Device, EmbreeParams, EmbreeScene};
 use std::sync::Arc;
 use std::time::Instant;
@@ -77,7 +77,7 @@ fn main() {
     };
     let _device = Device::shared(&embree.config_string()).expect("Embree device");
     let binned = BvhParams::binned();
-    let wide = Bvh8Params::default();
+    let wide = WideParams::default();
     let bin4 = wide.binary.clone();
 
     type Build<'a> = Box<dyn Fn() -> Box<dyn Accel> + Sync + 'a>;

@@ -1,5 +1,5 @@
 //! Deciding whether two closest-point answers for the same query agree: the point analogue of
-//! [`crate::compare`], shared by the conformance suite (testkit, against brute force) and the
+//! [`crate::classify`], shared by the conformance suite (testkit, against brute force) and the
 //! harness (`run` and `verify`, against Embree's `rtcPointQuery`).
 //!
 //! Each query falls in one [`Verdict`] (the ray classes, read for points): `BothMiss` (neither
@@ -10,7 +10,7 @@
 //! (anything else: a bug). Points have no edge ambiguity: `EdgeAmbiguous` never occurs.
 
 use crate::PointHit;
-use crate::compare::Verdict;
+use crate::classify::Verdict;
 use raybench_geom::{Aabb, TriangleMesh, Vec3, distance_to_triangle_f64};
 
 /// Tolerance in f32 ulps (machine epsilon times the largest |coordinate| of the mesh and the
