@@ -14,12 +14,8 @@
 //! | `bvh-binned` | binned SAH (Wald 2007) | ordered |
 //! | `bvh-binned-unordered` | binned SAH | fixed child order |
 
-#[cfg(target_arch = "x86_64")]
-mod avx2;
 pub mod build;
 mod node;
-#[cfg(target_arch = "x86_64")]
-mod packet;
 mod point;
 mod simd;
 mod traverse;

@@ -20,7 +20,7 @@
 //!
 //! Exactness: every lane computes what the single-ray walk computes for its ray, operation for
 //! operation — the slab test with the near planes chosen by the direction's signs
-//! ([`crate::avx2`]), Möller–Trumbore as in [`raybench_geom::Tri4::test`] (no fused
+//! ([`super::avx2`]), Möller–Trumbore as in [`raybench_geom::Tri4::test`] (no fused
 //! multiply-add) — so each ray's hit, `t`, `u` and `v` are the single-ray walk's, bit for bit.
 //! Only the order in which triangles are met differs, so on an exact tie (two triangles at
 //! the same `t`) the reported triangle may be the other one, as between any two structures.

@@ -1,173 +1,23 @@
-//! The AVX2 kernels of the wide BVHs, chosen at run time: the 8-wide node test in one pass of
-//! 8-lane arithmetic per axis, and leaves tested two packets a pass.
-//!
-//! The SSE kernel ([`crate::wide::SseNodes`]) needs two 4-lane passes per axis for an 8-wide
-//! node; AVX2 does the same arithmetic in one, lane for lane: `max`/`min` keep the accumulator
-//! when a lane is NaN (`0 * inf` for a ray in a box's face plane, bug class B1), the compare is
-//! ordered (false on NaN). [`Avx2Nodes`] can only be made by [`Avx2Nodes::detect`], after the
-//! CPU has reported AVX2, which is what makes calling the `#[target_feature]` code sound.
-//! AVX-512 adds no arithmetic an 8-lane f32 test needs, so there is no AVX-512 kernel. What it
-//! adds is registers: 32 vector registers instead of 16. The walk keeps ten splatted values of
-//! the ray live (origin, direction, inverse direction, `t_min`); with AVX2's sixteen, the
-//! compiler spilled them and reloaded six at every node. The batch loops are therefore
-//! compiled twice ([`batch_loops`]), once with AVX-512F and VL enabled; the same arithmetic
-//! runs in both, so the answers and counters are the same. Over the 17 scenes of the default
-//! suite, best of 10 passes interleaved with embree-medium in one process (`examples/wide.rs`,
-//! this VM's Zen 4, 2026-11-21), the AVX-512 loops against the AVX2 ones, three sweeps:
-//! primary +7.4 / +7.1 / +7.0 %, random +5.2 / +3.7 / +4.2 %, shadow +5.8 / +6.8 / +2.3 %.
-//!
 //! Leaves get the same treatment: two [`Tri4`] packets in one 8-lane Möller–Trumbore pass
 //! ([`leaf_pairs`]), the same operations lane for lane as the SSE packet test and the same
 //! choice among lanes. Bunny, 20 000 rays a workload, callgrind: primary 19.38M → 18.66M
 //! instructions, shadow 9.92M → 9.73M; timed, hair shadow rays 0.80 → 0.93× embree-medium
 //! and soup and grass 3–5 % faster (this VM, 2026-11-21).
 
-use crate::simd::F4;
-use crate::wide::{BvhWide, NodeKernel, Stack, WideNode, slab_quads};
-use raybench_accel::{CounterSink, Hit, NoCount};
-use raybench_geom::Tri4;
+use super::Avx2Ray;
 use raybench_geom::tri4::nearest_lane;
-use raybench_geom::{Ray, TriHit};
+use raybench_geom::{Tri4, TriHit};
 use std::arch::x86_64::*;
 
-/// Proof that this CPU runs AVX2 (the only way to reach the AVX2 code), and whether the batch
-/// loops may also use AVX-512VL's 32 vector registers.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Avx2Nodes {
-    wide_registers: bool,
-}
-
-impl Avx2Nodes {
-    /// AVX2 when the CPU has it; with `avx512` also AVX-512F and VL when it has them.
-    pub(crate) fn detect(avx512: bool) -> Option<Avx2Nodes> {
-        std::arch::is_x86_feature_detected!("avx2").then(|| Avx2Nodes {
-            wide_registers: avx512
-                && std::arch::is_x86_feature_detected!("avx512f")
-                && std::arch::is_x86_feature_detected!("avx512vl"),
-        })
-    }
-
-    /// Whether the batch loops run with AVX-512VL's registers.
-    pub(crate) fn wide_registers(self) -> bool {
-        self.wide_registers
-    }
-}
-
-/// The ray for the AVX2 tests: origin, direction, inverse direction and `t_min` splatted to 8
-/// lanes, and per axis which stored side (min or max) holds the near planes.
-pub(crate) struct Avx2Ray {
-    origin: [__m256; 3],
-    inv: [__m256; 3],
-    near: [bool; 3],
-    dir: [__m256; 3],
-    t_min: __m256,
-}
-
-#[target_feature(enable = "avx2")]
-fn splat_ray(ray: &Ray) -> Avx2Ray {
-    let inv = ray.inv_dir().to_array();
-    let origin = ray.origin().to_array();
-    Avx2Ray {
-        origin: origin.map(|x| _mm256_set1_ps(x)),
-        inv: inv.map(|x| _mm256_set1_ps(x)),
-        // -0 counts as negative: its inverse is -inf (bug class B3).
-        near: inv.map(|x| x.is_sign_negative()),
-        dir: ray.dir().to_array().map(|x| _mm256_set1_ps(x)),
-        t_min: _mm256_set1_ps(ray.t_min()),
-    }
-}
-
-/// The eight lanes `8 * o ..` of a plane row, for one AVX load.
-#[inline(always)]
-fn oct<const W: usize>(row: &[f32; W], o: usize) -> &[f32; 8] {
-    &row.as_chunks::<8>().0[o]
-}
-
-/// One pass per axis and eight children.
-#[target_feature(enable = "avx2")]
-#[inline]
-fn test_octs<const W: usize>(
-    r: &Avx2Ray,
-    n: &WideNode<W>,
-    t_min: f32,
-    t_max: f32,
-) -> (u32, [f32; W]) {
-    let mut mask = 0;
-    let mut entry = [0.0f32; W];
-    for o in 0..W / 8 {
-        let mut t0 = _mm256_set1_ps(t_min);
-        let mut t1 = _mm256_set1_ps(t_max);
-        for a in 0..3 {
-            let near = oct(&n.planes[a][r.near[a] as usize], o);
-            let far = oct(&n.planes[a][!r.near[a] as usize], o);
-            // SAFETY: each is a reference to 8 contiguous initialised f32s, and `loadu` has
-            // no alignment requirement.
-            let (near, far) = unsafe {
-                (
-                    _mm256_loadu_ps(near.as_ptr()),
-                    _mm256_loadu_ps(far.as_ptr()),
-                )
-            };
-            t0 = _mm256_max_ps(
-                _mm256_mul_ps(_mm256_sub_ps(near, r.origin[a]), r.inv[a]),
-                t0,
-            );
-            t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, r.origin[a]), r.inv[a]), t1);
-        }
-        mask |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32) << (8 * o);
-        let out: &mut [f32; 8] = &mut entry.as_chunks_mut::<8>().0[o];
-        // SAFETY: `out` is 8 writable f32s; `storeu` has no alignment requirement.
-        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), t0) };
-    }
-    (mask, entry)
-}
-
-impl<const W: usize> NodeKernel<W> for Avx2Nodes {
-    type Ray = Avx2Ray;
-
-    #[inline(always)]
-    fn ray(self, ray: &Ray) -> Avx2Ray {
-        // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.
-        unsafe { splat_ray(ray) }
-    }
-
-    #[inline(always)]
-    fn test(self, ray: &Avx2Ray, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]) {
-        // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.
-        unsafe {
-            if W.is_multiple_of(8) {
-                test_octs(ray, n, t_min, t_max)
-            } else {
-                // 4 wide: the SSE kernel's arithmetic on the low halves of the splatted ray.
-                let low = |v: &[__m256; 3]| v.map(|x| F4::from_m128(_mm256_castps256_ps128(x)));
-                slab_quads(&low(&ray.origin), &low(&ray.inv), ray.near, n, t_min, t_max)
-            }
-        }
-    }
-
-    #[inline(always)]
-    fn leaf<const ANY_HIT: bool>(
-        self,
-        ray: &Avx2Ray,
-        packets: &[Tri4],
-        first: usize,
-        best_t: &mut f32,
-        best: &mut Option<(usize, TriHit)>,
-    ) -> bool {
-        // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.
-        unsafe { leaf_pairs::<ANY_HIT>(ray, packets, first, best_t, best) }
-    }
-}
-
 /// A leaf's packets two at a time, one 8-lane pass per pair (a last odd packet alone, its upper
-/// lanes zero), with [`crate::wide::intersect_packets`]'s answers: the same arithmetic lane for
+/// lanes zero), with [`crate::wide::kernels::intersect_packets`]'s answers: the same arithmetic lane for
 /// lane as [`Tri4::intersect`], and the same choice among lanes, so the hit (and on an exact
 /// tie, the triangle) is the one the packet-by-packet loop reports. Leaves of two or more
 /// packets (the bunny's mean leaf holds 9.8 triangles, about three packets) take half the
 /// passes.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn leaf_pairs<const ANY_HIT: bool>(
+pub(super) fn leaf_pairs<const ANY_HIT: bool>(
     r: &Avx2Ray,
     packets: &[Tri4],
     first: usize,
@@ -323,111 +173,12 @@ fn test8(r: &Avx2Ray, a: &Tri4, b: Option<&Tri4>, t_max: f32) -> Option<(usize, 
     })
 }
 
-/// [`BvhWide::walk_with`] compiled for AVX2, so [`test_octs`] inlines into the loop.
-#[target_feature(enable = "avx2")]
-fn walk_ray_avx2<const W: usize, const ANY_HIT: bool, C: CounterSink>(
-    bvh: &BvhWide<W>,
-    k: Avx2Nodes,
-    ray: &Ray,
-    stack: &mut Stack,
-    c: &mut C,
-) -> Option<Hit> {
-    bvh.walk_with::<ANY_HIT, C, Avx2Nodes>(k, ray, stack, c)
-}
-
-#[inline(always)]
-pub(crate) fn walk_ray<const W: usize, const ANY_HIT: bool, C: CounterSink>(
-    bvh: &BvhWide<W>,
-    k: Avx2Nodes,
-    ray: &Ray,
-    stack: &mut Stack,
-    c: &mut C,
-) -> Option<Hit> {
-    // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
-    unsafe { walk_ray_avx2::<W, ANY_HIT, C>(bvh, k, ray, stack, c) }
-}
-
-/// The batch loops, once per instruction set: the loop lives inside the `#[target_feature]`
-/// code, so a ray pays no call, prologue or kernel dispatch of its own. The AVX-512 copies run
-/// the same AVX2 arithmetic lane for lane (so the same answers); what they gain is sixteen more
-/// vector registers, so the splatted ray (origin, direction, inverse direction, `t_min`: ten
-/// registers) no longer spills to the stack and is reloaded at every node.
-macro_rules! batch_loops {
-    ($features:literal, $closest:ident, $any:ident) => {
-        #[target_feature(enable = $features)]
-        fn $closest<const W: usize>(
-            bvh: &BvhWide<W>,
-            k: Avx2Nodes,
-            rays: &[Ray],
-            out: &mut [Option<Hit>],
-            stack: &mut Stack,
-        ) {
-            for (o, ray) in out.iter_mut().zip(rays) {
-                *o = bvh.walk_with::<false, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount);
-            }
-        }
-
-        #[target_feature(enable = $features)]
-        fn $any<const W: usize>(
-            bvh: &BvhWide<W>,
-            k: Avx2Nodes,
-            rays: &[Ray],
-            out: &mut [bool],
-            stack: &mut Stack,
-        ) {
-            for (o, ray) in out.iter_mut().zip(rays) {
-                *o = bvh
-                    .walk_with::<true, NoCount, Avx2Nodes>(k, ray, stack, &mut NoCount)
-                    .is_some();
-            }
-        }
-    };
-}
-
-batch_loops!("avx2", intersect_all_avx2, occluded_all_avx2);
-batch_loops!(
-    "avx2,avx512f,avx512vl",
-    intersect_all_avx512,
-    occluded_all_avx512
-);
-
-pub(crate) fn intersect_all<const W: usize>(
-    bvh: &BvhWide<W>,
-    k: Avx2Nodes,
-    rays: &[Ray],
-    out: &mut [Option<Hit>],
-    stack: &mut Stack,
-) {
-    if k.wide_registers {
-        // SAFETY: `k` says AVX-512F and VL only when `detect` saw them on this CPU.
-        unsafe { intersect_all_avx512(bvh, k, rays, out, stack) }
-    } else {
-        // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
-        unsafe { intersect_all_avx2(bvh, k, rays, out, stack) }
-    }
-}
-
-pub(crate) fn occluded_all<const W: usize>(
-    bvh: &BvhWide<W>,
-    k: Avx2Nodes,
-    rays: &[Ray],
-    out: &mut [bool],
-    stack: &mut Stack,
-) {
-    if k.wide_registers {
-        // SAFETY: `k` says AVX-512F and VL only when `detect` saw them on this CPU.
-        unsafe { occluded_all_avx512(bvh, k, rays, out, stack) }
-    } else {
-        // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
-        unsafe { occluded_all_avx2(bvh, k, rays, out, stack) }
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::{Avx2Nodes, splat_ray};
     use super::*;
-    use crate::wide::intersect_packets;
-    use raybench_geom::{MollerTriangle, Triangle, Vec3};
+    use crate::wide::kernels::intersect_packets;
+    use raybench_geom::{MollerTriangle, Ray, Triangle, Vec3};
 
     type Answer = (bool, u32, Option<(usize, u32, u32, u32)>);
 

@@ -1,0 +1,147 @@
+//! The wide tree's invariant check.
+
+use super::BvhWide;
+use crate::node::{ChildRef, MAX_DEPTH};
+use raybench_geom::{Aabb, MollerTriangle, NO_PRIM, Tri4, TriangleMesh};
+
+impl<const W: usize> BvhWide<W> {
+    /// The mesh index of every packet lane in order (`4 * packet + lane`), [`NO_PRIM`] for
+    /// unused lanes.
+    fn lane_ids(&self) -> impl Iterator<Item = u32> + '_ {
+        self.packets.iter().flat_map(|p| p.ids)
+    }
+
+    /// Every child box inside its parent's; leaves tiling the packets in depth-first order,
+    /// their triangles in the first lanes and the rest empty; every lane equal to its mesh
+    /// triangle; every mesh triangle exactly once; depth within the stack bound.
+    pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
+        let n = mesh.len();
+        self.check_lanes(mesh)?;
+        if n == 0 {
+            return Ok(());
+        }
+        let (mut covered, mut interior) = (0, 0);
+        self.walk(
+            mesh,
+            self.root,
+            &self.root_bounds,
+            0,
+            &mut covered,
+            &mut interior,
+        )?;
+        if covered != self.packets.len() || interior != self.nodes.len() {
+            return Err(format!(
+                "leaves hold {covered} of {} packets; {interior} of {} nodes reachable",
+                self.packets.len(),
+                self.nodes.len()
+            ));
+        }
+        Ok(())
+    }
+
+    /// Every used lane is its mesh triangle, every mesh triangle is in exactly one lane, and
+    /// unused lanes are the all-zero triangle.
+    fn check_lanes(&self, mesh: &TriangleMesh) -> Result<(), String> {
+        let mut seen = vec![false; mesh.len()];
+        for (slot, id) in self.lane_ids().enumerate() {
+            let lane = self.packets[slot / 4].lane(slot % 4);
+            if id == NO_PRIM {
+                if lane != Tri4::default().lane(0) {
+                    return Err(format!("unused lane {slot} holds a triangle"));
+                }
+                continue;
+            }
+            let s = seen
+                .get_mut(id as usize)
+                .ok_or(format!("prim id {id} out of range"))?;
+            if std::mem::replace(s, true) {
+                return Err(format!("prim id {id} appears twice"));
+            }
+            if lane != MollerTriangle::new(&mesh.triangle(id as usize)) {
+                return Err(format!("lane {slot} is not mesh triangle {id}"));
+            }
+        }
+        match seen.iter().position(|&s| !s) {
+            Some(missing) => Err(format!("mesh triangle {missing} is in no leaf")),
+            None => Ok(()),
+        }
+    }
+
+    fn walk(
+        &self,
+        mesh: &TriangleMesh,
+        r: ChildRef,
+        bounds: &Aabb,
+        depth: usize,
+        covered: &mut usize,
+        interior: &mut usize,
+    ) -> Result<(), String> {
+        if depth >= MAX_DEPTH {
+            return Err(format!("depth {depth} exceeds {MAX_DEPTH}"));
+        }
+        if r.is_leaf() {
+            return self.walk_leaf(mesh, r, bounds, covered);
+        }
+        if r.index as usize != *interior {
+            return Err(format!("node {} out of depth-first order", r.index));
+        }
+        *interior += 1;
+        let node = self
+            .nodes
+            .get(r.index as usize)
+            .ok_or("node index out of range")?;
+        let used = node.children();
+        if used < 2 {
+            return Err(format!("node {} has {used} children", r.index));
+        }
+        for i in 0..W {
+            let child = node.child_bounds(i);
+            if i >= used {
+                if !child.is_empty() {
+                    return Err(format!("node {} has a box in unused slot {i}", r.index));
+                }
+                continue;
+            }
+            if !bounds.contains_box(&child) {
+                return Err(format!(
+                    "child {i} of node {} is not inside its parent",
+                    r.index
+                ));
+            }
+            self.walk(mesh, node.child[i], &child, depth + 1, covered, interior)?;
+        }
+        Ok(())
+    }
+}
+
+impl<const W: usize> BvhWide<W> {
+    /// A leaf: at the next packet in depth-first order, `count` used lanes followed by unused
+    /// ones, every triangle inside the leaf's box.
+    fn walk_leaf(
+        &self,
+        mesh: &TriangleMesh,
+        r: ChildRef,
+        bounds: &Aabb,
+        covered: &mut usize,
+    ) -> Result<(), String> {
+        if r.index as usize != *covered {
+            return Err(format!("leaf at packet {}, expected {covered}", r.index));
+        }
+        let packets = (r.count as usize).div_ceil(4);
+        let first = r.index as usize;
+        let leaf = self
+            .packets
+            .get(first..first + packets)
+            .ok_or("leaf runs past the packets")?;
+        for (k, &id) in leaf.iter().flat_map(|p| &p.ids).enumerate() {
+            if (k < r.count as usize) != (id != NO_PRIM) {
+                return Err(format!("leaf at packet {} has lane {k} misused", r.index));
+            }
+            if id != NO_PRIM && !bounds.contains_box(&mesh.triangle(id as usize).bounds()) {
+                return Err(format!("leaf box does not contain triangle {id}"));
+            }
+        }
+        *covered += packets;
+        Ok(())
+    }
+}

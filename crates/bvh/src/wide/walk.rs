@@ -1,0 +1,201 @@
+//! The traversal loop, its stack and the child ordering.
+
+use super::kernels::{NodeKernel, SseNodes};
+use super::node::WideNode;
+use super::{BvhWide, MAX_WIDTH};
+use crate::node::{ChildRef, MAX_DEPTH};
+use crate::simd::prefetch;
+use raybench_accel::{CounterSink, Hit};
+use raybench_geom::{Ray, TriHit};
+use std::cell::RefCell;
+
+/// Stack entries a walk can need: a node pushes at most `MAX_WIDTH - 1`, one per level, and
+/// the binary builder caps the depth at [`MAX_DEPTH`] (collapsing only shortens it).
+pub(crate) const STACK: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
+
+type Entry = (ChildRef, f32);
+
+/// A traversal stack: subtrees still to visit with their entry distances.
+pub(crate) type Stack = [Entry; STACK];
+
+pub(crate) fn new_stack() -> Box<Stack> {
+    Box::new([(ChildRef::default(), 0.0); STACK])
+}
+
+thread_local! {
+    /// The single-ray paths' traversal stack, allocated once per thread.
+    static STACK_TLS: RefCell<Box<Stack>> = RefCell::new(new_stack());
+}
+
+/// Any hit will do, so no sorting (as Embree's occlusion traversal): returns the child in the
+/// lowest slot of `mask` and pushes the others to pop in slot order. Their entry distances are
+/// not kept: an any-hit walk ends at its first hit, so `t_max` never shrinks and no pushed
+/// subtree is ever skipped (the pop does not look at them either).
+#[inline(always)]
+fn first_in_slot_order<const W: usize>(
+    n: &WideNode<W>,
+    mask: u32,
+    stack: &mut Stack,
+    sp: &mut usize,
+) -> ChildRef {
+    let first = mask.trailing_zeros() as usize;
+    let mut rest = mask & (mask - 1);
+    while rest != 0 {
+        let i = 31 - rest.leading_zeros() as usize;
+        rest &= !(1 << i);
+        stack[*sp] = (n.child[i], 0.0);
+        *sp += 1;
+    }
+    n.child[first]
+}
+
+/// Of the children of `n` in `mask` (entry distances `entry`), returns the nearest and pushes
+/// the others so that they pop nearest first (equal distances: lower slot first). One and two
+/// children — most nodes — take a short path; more are inserted into the stack in place.
+#[inline(always)]
+fn nearest_first<const W: usize>(
+    n: &WideNode<W>,
+    mut mask: u32,
+    entry: &[f32; W],
+    stack: &mut Stack,
+    sp: &mut usize,
+) -> ChildRef {
+    let a = mask.trailing_zeros() as usize;
+    mask &= mask - 1;
+    if mask == 0 {
+        return n.child[a];
+    }
+    let b = mask.trailing_zeros() as usize;
+    mask &= mask - 1;
+    if mask == 0 {
+        let (near, far) = if entry[b] < entry[a] { (b, a) } else { (a, b) };
+        stack[*sp] = (n.child[far], entry[far]);
+        *sp += 1;
+        return n.child[near];
+    }
+    // Three or more: keep stack[base..] in decreasing distance, the nearest on top; a later
+    // (higher) slot goes below earlier slots at the same distance.
+    let base = *sp;
+    let mut insert = |i: usize| {
+        let e = (n.child[i], entry[i]);
+        let mut j = *sp;
+        while j > base && stack[j - 1].1 <= e.1 {
+            stack[j] = stack[j - 1];
+            j -= 1;
+        }
+        stack[j] = e;
+        *sp += 1;
+    };
+    insert(a);
+    insert(b);
+    while mask != 0 {
+        insert(mask.trailing_zeros() as usize);
+        mask &= mask - 1;
+    }
+    *sp -= 1;
+    stack[*sp].0
+}
+
+impl<const W: usize> BvhWide<W> {
+    /// The one traversal loop — closest or any hit, counted or not — for a given node
+    /// kernel. `stack` is scratch space, so batch callers reuse one allocation for all their
+    /// rays. There is no separate test of the root box: the root node's test covers it.
+    #[inline(always)]
+    pub(crate) fn walk_with<const ANY_HIT: bool, C: CounterSink, K: NodeKernel<W>>(
+        &self,
+        kernel: K,
+        ray: &Ray,
+        stack: &mut Stack,
+        c: &mut C,
+    ) -> Option<Hit> {
+        if self.packets.is_empty() {
+            return None;
+        }
+        let t_min = ray.t_min();
+        let mut best_t = ray.t_max();
+        let wide = kernel.ray(ray);
+        let mut best: Option<(usize, TriHit)> = None;
+        let mut sp = 0;
+        let mut r = self.root;
+        'walk: loop {
+            if r.is_leaf() {
+                c.leaf();
+                c.prim_tests(r.count as u64);
+                let first = r.index as usize;
+                let leaf = &self.packets[first..first + (r.count as usize).div_ceil(4)];
+                if kernel.leaf::<ANY_HIT>(&wide, leaf, first, &mut best_t, &mut best) {
+                    break 'walk;
+                }
+            } else {
+                c.node();
+                let n = &self.nodes[r.index as usize];
+                let (mask, entry) = kernel.test(&wide, n, t_min, best_t);
+                if mask != 0 {
+                    self.prefetch_children(n, mask);
+                    r = if ANY_HIT {
+                        first_in_slot_order(n, mask, stack, &mut sp)
+                    } else {
+                        nearest_first(n, mask, &entry, stack, &mut sp)
+                    };
+                    continue 'walk;
+                }
+            }
+            // Pop the nearest pushed subtree that may still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    break 'walk;
+                }
+                sp -= 1;
+                let (next, t_entry) = stack[sp];
+                if ANY_HIT || t_entry <= best_t {
+                    r = next;
+                    continue 'walk;
+                }
+            }
+        }
+        best.map(|(lane, h)| Hit {
+            t: h.t,
+            prim: self.packets[lane / 4].ids[lane % 4],
+            u: h.u,
+            v: h.v,
+        })
+    }
+
+    /// Starts fetching every child in `mask`: a node's four (8 wide) or two (4 wide) lines, or
+    /// a leaf's first packet (three lines).
+    #[inline(always)]
+    fn prefetch_children(&self, n: &WideNode<W>, mut mask: u32) {
+        while mask != 0 {
+            let r = n.child[mask.trailing_zeros() as usize];
+            mask &= mask - 1;
+            if r.is_leaf() {
+                prefetch(self.packets.as_ptr().wrapping_add(r.index as usize));
+            } else {
+                prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
+            }
+        }
+    }
+
+    /// [`BvhWide::walk_with`] with the kernel chosen at build time.
+    #[inline(always)]
+    pub(super) fn trace<const ANY_HIT: bool, C: CounterSink>(
+        &self,
+        ray: &Ray,
+        stack: &mut Stack,
+        c: &mut C,
+    ) -> Option<Hit> {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(k) = self.avx2 {
+            return super::avx2::walk_ray::<W, ANY_HIT, C>(self, k, ray, stack, c);
+        }
+        self.walk_with::<ANY_HIT, C, SseNodes>(SseNodes, ray, stack, c)
+    }
+
+    pub(super) fn trace_single<const ANY_HIT: bool, C: CounterSink>(
+        &self,
+        ray: &Ray,
+        c: &mut C,
+    ) -> Option<Hit> {
+        STACK_TLS.with(|s| self.trace::<ANY_HIT, C>(ray, &mut s.borrow_mut(), c))
+    }
+}
