@@ -56,8 +56,10 @@ pub struct BvhParams {
     pub traversal_cost: f32,
     /// SAH cost of one ray–triangle test, for the builder's split decisions.
     pub intersection_cost: f32,
-    /// Triangles tested together in a leaf (1: one at a time; 4: the wide BVH's SIMD packets).
-    /// The SAH prices a leaf by the packets it fills, so a leaf of 3 costs as much as one of 4.
+    /// Triangles tested together in a leaf (1: one at a time; 4: the wide BVH's [`Tri4`]s).
+    /// The SAH prices a leaf by the blocks it fills, so a leaf of 3 costs as much as one of 4.
+    ///
+    /// [`Tri4`]: raybench_geom::Tri4
     pub leaf_block: u32,
     /// A node with more triangles than this is always split (if its triangles can be told
     /// apart at all; see `build`).

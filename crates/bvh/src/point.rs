@@ -134,7 +134,7 @@ pub(crate) struct WideView<'a, const W: usize> {
     pub root: ChildRef,
     pub root_bounds: &'a Aabb,
     pub nodes: &'a [WideNode<W>],
-    pub packets: &'a [Tri4],
+    pub tri4s: &'a [Tri4],
     pub mesh: &'a TriangleMesh,
 }
 
@@ -188,7 +188,7 @@ pub(crate) fn closest_point_wide<const W: usize, C: CounterSink>(
     c: &mut C,
 ) -> Option<PointHit> {
     let mut nearest = Nearest::within(p, max_radius)?;
-    if bvh.packets.is_empty() || box_distance_squared(p, bvh.root_bounds) > nearest.bound_d2() {
+    if bvh.tri4s.is_empty() || box_distance_squared(p, bvh.root_bounds) > nearest.bound_d2() {
         return None;
     }
     let splat = SplatPoint::new(p);
@@ -224,7 +224,7 @@ pub(crate) fn closest_point_wide<const W: usize, C: CounterSink>(
     }
 }
 
-/// The `count` used lanes of the leaf's packets, one exact distance each.
+/// The `count` used lanes of the leaf's `Tri4`s, one exact distance each.
 #[inline(always)]
 fn wide_leaf<const W: usize, C: CounterSink>(
     bvh: &WideView<'_, W>,
@@ -236,7 +236,7 @@ fn wide_leaf<const W: usize, C: CounterSink>(
     let first = 4 * r.index as usize;
     for slot in first..first + r.count as usize {
         c.prim_tests(1);
-        let prim = bvh.packets[slot / 4].ids[slot % 4];
+        let prim = bvh.tri4s[slot / 4].ids[slot % 4];
         nearest.test_triangle(p, prim, &bvh.mesh.triangle(prim as usize));
     }
 }

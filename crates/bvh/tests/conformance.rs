@@ -198,7 +198,7 @@ fn wide_trees_are_the_same_with_one_and_two_threads() {
             "big enough to collapse in parallel"
         );
         assert!(one.nodes() == two.nodes(), "{W} wide: nodes differ");
-        assert!(one.packets() == two.packets(), "{W} wide: packets differ");
+        assert!(one.tri4s() == two.tri4s(), "{W} wide: Tri4s differ");
     }
     let mesh = raybench_testkit::scenes::generate("teapot:triangles=20000", 1)
         .expect("generates")
@@ -209,8 +209,8 @@ fn wide_trees_are_the_same_with_one_and_two_threads() {
 
 /// The SSE kernels (what a CPU without AVX2 runs) answer like the AVX2 ones, at width `W`:
 /// the same suite, and the same hits and counters ray for ray on a seeded scene, with leaves
-/// small enough for one packet and large enough for several (the AVX2 leaf test takes two
-/// packets a pass).
+/// small enough for one `Tri4` and large enough for several (the AVX2 leaf test takes two
+/// `Tri4`s a pass).
 fn sse_matches_avx2_at<const W: usize>() {
     use raybench_accel::{Accel, Counters};
     let sse = WideParams {

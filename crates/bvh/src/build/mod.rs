@@ -47,7 +47,7 @@ pub(crate) struct Flat {
 
 /// Peak bytes per triangle of a build: its 32-byte record, up to one 64-byte node in the
 /// per-task vectors and again in the flattened array, its id, and its 48-byte triangle copy
-/// (or its share of a wide tree's packets and nodes, no more than that).
+/// (or its share of a wide tree's `Tri4`s and nodes, no more than that).
 const PEAK_BYTES_PER_TRIANGLE: u64 = 32 + 2 * 64 + 4 + 48;
 
 pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, BuildError> {

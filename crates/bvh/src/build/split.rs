@@ -46,7 +46,7 @@ fn split_cost(p: &BvhParams, parent: f64, left: (f64, usize), right: (f64, usize
             / parent
 }
 
-/// The triangle tests a leaf of `n` costs: `n` rounded up to whole packets of `leaf_block`
+/// The triangle tests a leaf of `n` costs: `n` rounded up to whole blocks of `leaf_block`
 /// (a mask for the usual power of two: the binned sweep calls this six times a boundary).
 #[inline(always)]
 fn blocks(p: &BvhParams, n: usize) -> f64 {
@@ -65,8 +65,7 @@ fn worth_splitting(p: &BvhParams, n: usize, best_cost: f64) -> bool {
 }
 
 /// Whether no split of `n` triangles can be worth taking, whatever the split: when they fit
-/// in a leaf that costs no more than one node step (with the wide tree's knobs, up to one packet
-/// of four), since a split's cost is at least the traversal cost. Such a range becomes a leaf
+/// in a leaf that costs no more than one node step (with the wide tree's knobs, up to one `Tri4`), since a split's cost is at least the traversal cost. Such a range becomes a leaf
 /// without binning.
 pub(crate) fn leaf_beats_any_split(p: &BvhParams, n: usize) -> bool {
     n <= p.max_leaf_size as usize

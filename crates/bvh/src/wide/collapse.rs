@@ -14,7 +14,7 @@ pub(super) struct Binary<'a> {
     fill_slots: bool,
 }
 
-/// Leaves of more triangles than this (one packet) may be split to fill a node's empty slots.
+/// Leaves of more triangles than this (one `Tri4`) may be split to fill a node's empty slots.
 const SPLIT_LEAVES_ABOVE: u32 = 4;
 
 /// Subtrees of at least this many triangles collapse their children's subtrees on rayon.
@@ -56,7 +56,7 @@ impl Binary<'_> {
     /// (the first of them record `start`): starting from its two children, the interior child
     /// with the largest area is opened (first on ties: deterministic) until there are `W` or
     /// only leaves remain; slots still empty are filled by splitting the largest leaves of more
-    /// than one packet. Children stay in the order of their triangles.
+    /// than one `Tri4`. Children stay in the order of their triangles.
     fn open<const W: usize>(
         &self,
         refs: &mut [PrimRef],
@@ -110,7 +110,7 @@ impl Binary<'_> {
 
 /// Splits a leaf's triangles `refs` (the first of them record `first`) in two, forced (as
 /// Embree's wide builder splits every child of more than one block until the node is full):
-/// sorted by centroid on the axis where the centroids spread most, cut where `area × packets`
+/// sorted by centroid on the axis where the centroids spread most, cut where `area × Tri4s`
 /// summed over both halves is least (first on ties). One axis, not three: three sorts made the
 /// collapse about a third slower on the bunny for the same speed. Ties in the sort go by mesh
 /// index (deterministic).
@@ -125,7 +125,7 @@ fn split_leaf(refs: &mut [PrimRef], first: u32) -> [(ChildRef, Aabb); 2] {
             .total_cmp(&b.centroid2_on(axis))
             .then(a.id().cmp(&b.id()))
     });
-    let packets = |k: usize| k.div_ceil(4) as f64;
+    let tri4s = |k: usize| k.div_ceil(4) as f64;
     let n = refs.len();
     // The boxes of the right-hand halves `refs[k..]`, on the stack for the usual leaf sizes.
     let (mut small, mut large) = ([Box3::EMPTY; 32], Vec::new());
@@ -144,7 +144,7 @@ fn split_leaf(refs: &mut [PrimRef], first: u32) -> [(ChildRef, Aabb); 2] {
     let mut acc = Box3::EMPTY;
     for k in 1..n {
         acc = acc.union(&refs[k - 1].bounds());
-        let cost = acc.half_area() * packets(k) + right[k].half_area() * packets(n - k);
+        let cost = acc.half_area() * tri4s(k) + right[k].half_area() * tri4s(n - k);
         if cost < best {
             (best, cut, left) = (cost, k, acc);
         }
@@ -161,7 +161,7 @@ fn split_leaf(refs: &mut [PrimRef], first: u32) -> [(ChildRef, Aabb); 2] {
 
 /// Collapses the binary subtree `r`, whose triangles are `refs` (the first of them record
 /// `start`), into wide nodes appended to `out` depth-first. Leaves stay triangle ranges
-/// (`{ index: first record, count }`) until [`number_packets`]. A subtree of
+/// (`{ index: first record, count }`) until [`number_tri4s`]. A subtree of
 /// [`PARALLEL_COLLAPSE`] triangles or more collapses its children on rayon, each into a
 /// vector of its own, appended in slot order afterwards: the same nodes in the same order as
 /// one thread makes them.

@@ -12,12 +12,12 @@ pub(crate) trait NodeKernel<const W: usize>: Copy {
     type Ray;
     fn ray(self, ray: &Ray) -> Self::Ray;
     fn test(self, ray: &Self::Ray, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]);
-    /// The packets of one leaf (the first is packet `first` of the tree) against the ray below
-    /// `*best_t`, exactly as [`intersect_packets`] does it; true when an any-hit query may stop.
+    /// The `Tri4`s of one leaf (the first is `Tri4` `first` of the tree) against the ray below
+    /// `*best_t`, exactly as [`intersect_tri4s`] does it; true when an any-hit query may stop.
     fn leaf<const ANY_HIT: bool>(
         self,
         ray: &Self::Ray,
-        packets: &[Tri4],
+        tri4s: &[Tri4],
         first: usize,
         best_t: &mut f32,
         best: &mut Option<(usize, TriHit)>,
@@ -58,12 +58,12 @@ impl<const W: usize> NodeKernel<W> for SseNodes {
     fn leaf<const ANY_HIT: bool>(
         self,
         ray: &WideRay,
-        packets: &[Tri4],
+        tri4s: &[Tri4],
         first: usize,
         best_t: &mut f32,
         best: &mut Option<(usize, TriHit)>,
     ) -> bool {
-        intersect_packets::<ANY_HIT>(packets, first, &ray.ray, best_t, best)
+        intersect_tri4s::<ANY_HIT>(tri4s, first, &ray.ray, best_t, best)
     }
 
     #[inline(always)]
@@ -101,20 +101,20 @@ pub(crate) fn slab_quads<const W: usize>(
     (mask, entry)
 }
 
-/// Tests a leaf's packets (the first is packet `first` of the tree) one after the other below
-/// `*best_t`, keeping the closest hit (as a lane index `4 * packet + lane`); true when an
-/// any-hit query may stop. A later packet's lane replaces the best hit so far when its
-/// window test `t <= best_t` passes, so on an exact tie the later packet wins.
+/// Tests a leaf's `Tri4`s (the first is `Tri4` `first` of the tree) one after the other below
+/// `*best_t`, keeping the closest hit (as a lane index `4 * tri4 + lane`); true when an
+/// any-hit query may stop. A later `Tri4`'s lane replaces the best hit so far when its
+/// window test `t <= best_t` passes, so on an exact tie the later `Tri4` wins.
 #[inline(always)]
-pub(crate) fn intersect_packets<const ANY_HIT: bool>(
-    packets: &[Tri4],
+pub(crate) fn intersect_tri4s<const ANY_HIT: bool>(
+    tri4s: &[Tri4],
     first: usize,
     ray: &Ray,
     best_t: &mut f32,
     best: &mut Option<(usize, TriHit)>,
 ) -> bool {
-    for (k, packet) in packets.iter().enumerate() {
-        if let Some((lane, h)) = packet.intersect(ray, *best_t) {
+    for (k, tri4) in tri4s.iter().enumerate() {
+        if let Some((lane, h)) = tri4.intersect(ray, *best_t) {
             *best_t = h.t;
             *best = Some((4 * (first + k) + lane, h));
             if ANY_HIT {

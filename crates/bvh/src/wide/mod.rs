@@ -6,7 +6,7 @@
 //! builders): each wide node starts from a binary node's two children and repeatedly opens the
 //! child with the largest surface area — the one a ray is most likely to enter — until it has
 //! `W` children or only leaves remain; slots still empty then are filled by splitting the
-//! largest leaves of more than one packet in two (`fill_slots`, as Embree's builder splits
+//! largest leaves of more than one `Tri4` in two (`fill_slots`, as Embree's builder splits
 //! every child until the node is full: over the 17 default scenes shadow rays +2.3–2.8 %,
 //! primary −0.1 to +1.0 %, random +0.4–0.9 % in three sweeps, and the SAH cost with the
 //! shared constants 10–35 % lower, this VM, 2026-11-21). The
@@ -21,9 +21,9 @@
 //! overlaps the walk below the nearest (bunny random rays 0.97× → 1.11× embree-medium, this VM,
 //! 2026-11-21; prefetching only the pushed ones gained less).
 //!
-//! Leaves are SIMD packets ([`Tri4`]): the binary builder prices a leaf by the packets of four
+//! Leaves are [`Tri4`]s: the binary builder prices a leaf by the `Tri4`s of four triangles
 //! it fills (`leaf_block = 4`), and one SSE Möller–Trumbore test answers for four triangles;
-//! with AVX2 a leaf's packets are tested two at a time, eight lanes a pass
+//! with AVX2 a leaf's `Tri4`s are tested two at a time, eight lanes a pass
 //! ([`avx2`]), with the same answers.
 //! An 8-wide node is tested in one 8-lane AVX2 pass per axis when the CPU has AVX2 (detected
 //! at build time, [`avx2`]) and in two 4-lane SSE passes otherwise; both are the scalar
@@ -51,7 +51,7 @@ pub(crate) use walk::STACK;
 use crate::build;
 use crate::node::ChildRef;
 use collapse::{Binary, collapse};
-use pack::{number_packets, pack_leaves};
+use pack::{fill_tri4s, number_tri4s};
 use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Hit, Memory, NoCount, PreparedRays, Walk,
 };
@@ -62,16 +62,17 @@ use walk::new_stack;
 /// The widest node built (and the size of every traversal stack).
 pub const MAX_WIDTH: usize = 8;
 
-/// A wide BVH of `W`-child nodes. A leaf reference is `{ index: first packet, count:
-/// triangles }`; its triangles fill `count.div_ceil(4)` consecutive packets, lane by lane.
+/// A wide BVH of `W`-child nodes. A leaf reference is `{ index: first Tri4, count:
+/// triangles }`; its triangles fill `count.div_ceil(4)` consecutive `Tri4`s, lane by lane.
 #[derive(Debug)]
 pub struct BvhWide<const W: usize> {
     params: WideParams,
     nodes: Vec<WideNode<W>>,
     root: ChildRef,
     root_bounds: Aabb,
-    /// Leaf triangles, four to a packet, each lane with its mesh index ([`NO_PRIM`] unused).
-    packets: Vec<Tri4>,
+    /// Leaf triangles, four to a `Tri4`, each lane with its mesh index
+    /// ([`NO_PRIM`](raybench_geom::NO_PRIM) unused).
+    tri4s: Vec<Tri4>,
     /// The mesh as built, for closest-point queries (exact vertices).
     mesh: Arc<TriangleMesh>,
     #[cfg(target_arch = "x86_64")]
@@ -96,9 +97,9 @@ impl<const W: usize> BvhWide<W> {
         self.root
     }
 
-    /// The leaves' triangle packets, in depth-first order.
-    pub fn packets(&self) -> &[Tri4] {
-        &self.packets
+    /// The leaves' `Tri4`s, in depth-first order.
+    pub fn tri4s(&self) -> &[Tri4] {
+        &self.tri4s
     }
 
     /// The parts the closest-point walk reads (`point.rs`).
@@ -107,7 +108,7 @@ impl<const W: usize> BvhWide<W> {
             root: self.root,
             root_bounds: &self.root_bounds,
             nodes: &self.nodes,
-            packets: &self.packets,
+            tri4s: &self.tri4s,
             mesh: &self.mesh,
         }
     }
@@ -160,23 +161,23 @@ impl<const W: usize> Accel for BvhWide<W> {
         }
         let mut flat = build::build(&mesh, &params.binary)?;
         let mut nodes = Vec::with_capacity(flat.nodes.len() / 3 + 1);
-        // The collapse leaves the leaves as triangle ranges; their packets are numbered
+        // The collapse leaves the leaves as triangle ranges; their `Tri4`s are numbered
         // afterwards and filled in parallel.
         let (root, leaves) = if flat.refs.is_empty() {
             (ChildRef::default(), Vec::new())
         } else {
             let binary = Binary::new(&flat.nodes, params.fill_slots);
             let mut root = collapse(&binary, &mut flat.refs, 0, flat.root, &mut nodes);
-            let leaves = number_packets(&mut nodes, &mut root);
+            let leaves = number_tri4s(&mut nodes, &mut root);
             (root, leaves)
         };
-        let packets = pack_leaves(&mesh, &flat.refs, &leaves);
+        let tri4s = fill_tri4s(&mesh, &flat.refs, &leaves);
         Ok(BvhWide {
             params: params.clone(),
             nodes,
             root,
             root_bounds: flat.root_bounds,
-            packets,
+            tri4s,
             mesh,
             #[cfg(target_arch = "x86_64")]
             avx2: match params.node_simd {
@@ -261,9 +262,9 @@ impl<const W: usize> Accel for BvhWide<W> {
     fn memory(&self) -> Memory {
         Memory {
             nodes: std::mem::size_of_val(self.nodes.as_slice()) as u64,
-            // Triangle ids live in the packets.
+            // Triangle ids live in the `Tri4`s.
             indices: 0,
-            primitives: std::mem::size_of_val(self.packets.as_slice()) as u64,
+            primitives: std::mem::size_of_val(self.tri4s.as_slice()) as u64,
         }
     }
 }

@@ -5,59 +5,59 @@ use crate::build::PrimRef;
 use crate::node::ChildRef;
 use raybench_geom::{MollerTriangle, Tri4, TriangleMesh};
 
-/// One packet's triangles: the builder's records `refs[start..start + len]`, `len` 1 to 4.
+/// One `Tri4`'s triangles: the builder's records `refs[start..start + len]`, `len` 1 to 4.
 #[derive(Clone, Copy)]
-pub(super) struct PacketSource {
+pub(super) struct Tri4Source {
     start: u32,
     len: u32,
 }
 
-/// The packets in tree order (see [`number_packets`]), built on rayon: gathering each
+/// The `Tri4`s in tree order (see [`number_tri4s`]), built on rayon: gathering each
 /// triangle's vertices from the mesh is the part of the collapse that touches memory at
-/// random, and packets are independent. The length is known, so the indexed `collect` writes
-/// each packet straight into its place (a `flat_map` over leaves collected through per-task
+/// random, and `Tri4`s are independent. The length is known, so the indexed `collect` writes
+/// each `Tri4` straight into its place (a `flat_map` over leaves collected through per-task
 /// lists and a final copy: about 7 % of the 8-wide build's samples on the sphere, perf with 2
 /// threads, this VM, 2026-11-22). The result does not depend on the thread count.
-pub(super) fn pack_leaves(
+pub(super) fn fill_tri4s(
     mesh: &TriangleMesh,
     refs: &[PrimRef],
-    sources: &[PacketSource],
+    sources: &[Tri4Source],
 ) -> Vec<Tri4> {
     use rayon::prelude::*;
     sources
         .par_iter()
         .with_min_len(1024)
         .map(|s| {
-            let mut packet = Tri4::default();
+            let mut tri4 = Tri4::default();
             for (lane, p) in refs[s.start as usize..(s.start + s.len) as usize]
                 .iter()
                 .enumerate()
             {
                 let i = p.id();
-                packet.set_lane(lane, i, &MollerTriangle::new(&mesh.triangle(i as usize)));
+                tri4.set_lane(lane, i, &MollerTriangle::new(&mesh.triangle(i as usize)));
             }
-            packet
+            tri4
         })
         .collect()
 }
 
-/// Turns every leaf reference of the collapsed tree from a triangle range into its packets
-/// (`{ index: first packet, count: triangles }`), numbered in depth-first order, which is the
-/// order of the triangles; returns where each packet's triangles are, in that order.
-pub(super) fn number_packets<const W: usize>(
+/// Turns every leaf reference of the collapsed tree from a triangle range into its `Tri4`s
+/// (`{ index: first Tri4, count: triangles }`), numbered in depth-first order, which is the
+/// order of the triangles; returns where each `Tri4`'s triangles are, in that order.
+pub(super) fn number_tri4s<const W: usize>(
     nodes: &mut [WideNode<W>],
     r: &mut ChildRef,
-) -> Vec<PacketSource> {
+) -> Vec<Tri4Source> {
     fn visit<const W: usize>(
         nodes: &mut [WideNode<W>],
         r: &mut ChildRef,
-        sources: &mut Vec<PacketSource>,
+        sources: &mut Vec<Tri4Source>,
     ) {
         if r.is_leaf() {
             let first = r.index;
             r.index = sources.len() as u32;
             for k in (0..r.count).step_by(4) {
-                sources.push(PacketSource {
+                sources.push(Tri4Source {
                     start: first + k,
                     len: (r.count - k).min(4),
                 });

@@ -175,7 +175,7 @@ fn intersect_packets<const W: usize>(
 ) {
     for (block, out) in blocks.iter().zip(out.chunks_mut(PACKET)) {
         let (packet, mut best) = load_packet(block);
-        if !bvh.packets().is_empty() {
+        if !bvh.tri4s().is_empty() {
             // Bit `a` of a lane's octant: axis `a` points down (`-0` too: its inverse is -inf).
             let zero = _mm512_setzero_ps();
             let down = packet
@@ -343,8 +343,8 @@ fn flip(x: __m512, by: __m512) -> __m512 {
 #[target_feature(enable = "avx512f")]
 fn leaf<const W: usize>(bvh: &BvhWide<W>, r: ChildRef, p: &Packet, active: u16, best: &mut Best) {
     let first = r.index as usize;
-    let packets = &bvh.packets()[first..first + (r.count as usize).div_ceil(4)];
-    for tri4 in packets {
+    let tri4s = &bvh.tri4s()[first..first + (r.count as usize).div_ceil(4)];
+    for tri4 in tri4s {
         // The four normals `e2 × e1` in one 4-lane pass (the same operations as the 16-lane
         // `cross`, so the same bits), broadcast per triangle below.
         let ng4 = normals(tri4);
@@ -384,7 +384,7 @@ fn leaf<const W: usize>(bvh: &BvhWide<W>, r: ChildRef, p: &Packet, active: u16, 
     }
 }
 
-/// `e2 × e1` of a packet's four triangles, per axis, in glam's order.
+/// `e2 × e1` of a `Tri4`'s four triangles, per axis, in glam's order.
 #[inline(always)]
 fn normals(t: &Tri4) -> [[f32; 4]; 3] {
     let (e1, e2) = (t.e1.map(|r| F4::load(&r)), t.e2.map(|r| F4::load(&r)));

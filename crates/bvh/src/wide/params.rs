@@ -15,7 +15,7 @@ pub enum NodeSimd {
     /// AVX2 when the CPU has it, never AVX-512 (the kernels as they were before `Auto` used
     /// AVX-512's registers, for comparison).
     Avx2,
-    /// 4-lane SSE: one pass per axis and four children, one packet of four triangles a pass
+    /// 4-lane SSE: one pass per axis and four children, one `Tri4` (four triangles) a pass
     /// (the x86-64 baseline; portable code elsewhere).
     Sse,
 }
@@ -28,9 +28,9 @@ pub struct WideParams {
     /// Children per node: 8 ([`Bvh8`]) or 4 ([`Bvh4`]); a tree is built only with its own.
     pub width: u32,
     /// The kernels: with AVX2, 8-wide nodes take one 8-lane pass per axis (4-wide ones keep
-    /// one 4-lane pass) and leaves are tested two packets a pass.
+    /// one 4-lane pass) and leaves are tested two `Tri4`s a pass.
     pub node_simd: NodeSimd,
-    /// Split leaves of more than one packet into the slots a node would leave empty (see
+    /// Split leaves of more than one `Tri4` into the slots a node would leave empty (see
     /// [`collapse`]); off, the wide tree has exactly the binary tree's leaves.
     pub fill_slots: bool,
     /// Batches prepared as coherent (`Accel::prepare_coherent_rays`: the primary rays) are

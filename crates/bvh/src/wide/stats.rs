@@ -8,7 +8,7 @@ impl<const W: usize> BvhWide<W> {
     /// node test), with the constants shared by every structure.
     pub(super) fn measure(&self) -> BuildStats {
         let mut s = BuildStats::default();
-        if self.packets.is_empty() {
+        if self.tri4s.is_empty() {
             return s;
         }
         let root_area = self.root_bounds.surface_area();
@@ -45,8 +45,8 @@ impl<const W: usize> BvhWide<W> {
             s.refs as f64 / s.leaves.max(1) as f64,
         );
         s.extra.insert(
-            "packet_fill".into(),
-            s.refs as f64 / (4 * self.packets.len()).max(1) as f64,
+            "lane_fill".into(),
+            s.refs as f64 / (4 * self.tri4s.len()).max(1) as f64,
         );
         s.extra
             .insert("avx2_kernels".into(), self.uses_avx2() as u8 as f64);

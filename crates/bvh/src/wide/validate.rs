@@ -5,13 +5,13 @@ use crate::node::{ChildRef, MAX_DEPTH};
 use raybench_geom::{Aabb, MollerTriangle, NO_PRIM, Tri4, TriangleMesh};
 
 impl<const W: usize> BvhWide<W> {
-    /// The mesh index of every packet lane in order (`4 * packet + lane`), [`NO_PRIM`] for
+    /// The mesh index of every `Tri4` lane in order (`4 * tri4 + lane`), [`NO_PRIM`] for
     /// unused lanes.
     fn lane_ids(&self) -> impl Iterator<Item = u32> + '_ {
-        self.packets.iter().flat_map(|p| p.ids)
+        self.tri4s.iter().flat_map(|t| t.ids)
     }
 
-    /// Every child box inside its parent's; leaves tiling the packets in depth-first order,
+    /// Every child box inside its parent's; leaves tiling the `Tri4`s in depth-first order,
     /// their triangles in the first lanes and the rest empty; every lane equal to its mesh
     /// triangle; every mesh triangle exactly once; depth within the stack bound.
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
@@ -29,10 +29,10 @@ impl<const W: usize> BvhWide<W> {
             &mut covered,
             &mut interior,
         )?;
-        if covered != self.packets.len() || interior != self.nodes.len() {
+        if covered != self.tri4s.len() || interior != self.nodes.len() {
             return Err(format!(
-                "leaves hold {covered} of {} packets; {interior} of {} nodes reachable",
-                self.packets.len(),
+                "leaves hold {covered} of {} Tri4s; {interior} of {} nodes reachable",
+                self.tri4s.len(),
                 self.nodes.len()
             ));
         }
@@ -44,7 +44,7 @@ impl<const W: usize> BvhWide<W> {
     fn check_lanes(&self, mesh: &TriangleMesh) -> Result<(), String> {
         let mut seen = vec![false; mesh.len()];
         for (slot, id) in self.lane_ids().enumerate() {
-            let lane = self.packets[slot / 4].lane(slot % 4);
+            let lane = self.tri4s[slot / 4].lane(slot % 4);
             if id == NO_PRIM {
                 if lane != Tri4::default().lane(0) {
                     return Err(format!("unused lane {slot} holds a triangle"));
@@ -115,7 +115,7 @@ impl<const W: usize> BvhWide<W> {
 }
 
 impl<const W: usize> BvhWide<W> {
-    /// A leaf: at the next packet in depth-first order, `count` used lanes followed by unused
+    /// A leaf: at the next `Tri4` in depth-first order, `count` used lanes followed by unused
     /// ones, every triangle inside the leaf's box.
     fn walk_leaf(
         &self,
@@ -125,23 +125,23 @@ impl<const W: usize> BvhWide<W> {
         covered: &mut usize,
     ) -> Result<(), String> {
         if r.index as usize != *covered {
-            return Err(format!("leaf at packet {}, expected {covered}", r.index));
+            return Err(format!("leaf at Tri4 {}, expected {covered}", r.index));
         }
-        let packets = (r.count as usize).div_ceil(4);
+        let tri4s = (r.count as usize).div_ceil(4);
         let first = r.index as usize;
         let leaf = self
-            .packets
-            .get(first..first + packets)
-            .ok_or("leaf runs past the packets")?;
-        for (k, &id) in leaf.iter().flat_map(|p| &p.ids).enumerate() {
+            .tri4s
+            .get(first..first + tri4s)
+            .ok_or("leaf runs past the Tri4s")?;
+        for (k, &id) in leaf.iter().flat_map(|t| &t.ids).enumerate() {
             if (k < r.count as usize) != (id != NO_PRIM) {
-                return Err(format!("leaf at packet {} has lane {k} misused", r.index));
+                return Err(format!("leaf at Tri4 {} has lane {k} misused", r.index));
             }
             if id != NO_PRIM && !bounds.contains_box(&mesh.triangle(id as usize).bounds()) {
                 return Err(format!("leaf box does not contain triangle {id}"));
             }
         }
-        *covered += packets;
+        *covered += tri4s;
         Ok(())
     }
 }

@@ -108,7 +108,7 @@ impl<const W: usize> BvhWide<W> {
         stack: &mut Stack,
         c: &mut C,
     ) -> Option<Hit> {
-        if self.packets.is_empty() {
+        if self.tri4s.is_empty() {
             return None;
         }
         let t_min = ray.t_min();
@@ -122,7 +122,7 @@ impl<const W: usize> BvhWide<W> {
                 c.leaf();
                 c.prim_tests(r.count as u64);
                 let first = r.index as usize;
-                let leaf = &self.packets[first..first + (r.count as usize).div_ceil(4)];
+                let leaf = &self.tri4s[first..first + (r.count as usize).div_ceil(4)];
                 if kernel.leaf::<ANY_HIT>(&wide, leaf, first, &mut best_t, &mut best) {
                     break 'walk;
                 }
@@ -155,21 +155,21 @@ impl<const W: usize> BvhWide<W> {
         }
         best.map(|(lane, h)| Hit {
             t: h.t,
-            prim: self.packets[lane / 4].ids[lane % 4],
+            prim: self.tri4s[lane / 4].ids[lane % 4],
             u: h.u,
             v: h.v,
         })
     }
 
     /// Starts fetching every child in `mask`: a node's four (8 wide) or two (4 wide) lines, or
-    /// a leaf's first packet (three lines).
+    /// a leaf's first `Tri4` (three lines).
     #[inline(always)]
     fn prefetch_children(&self, n: &WideNode<W>, mut mask: u32) {
         while mask != 0 {
             let r = n.child[mask.trailing_zeros() as usize];
             mask &= mask - 1;
             if r.is_leaf() {
-                prefetch(self.packets.as_ptr().wrapping_add(r.index as usize));
+                prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
             } else {
                 prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
             }

@@ -1,5 +1,5 @@
-//! Leaves get the same treatment: two [`Tri4`] packets in one 8-lane Möller–Trumbore pass
-//! ([`leaf_pairs`]), the same operations lane for lane as the SSE packet test and the same
+//! Leaves get the same treatment: two [`Tri4`]s in one 8-lane Möller–Trumbore pass
+//! ([`leaf_pairs`]), the same operations lane for lane as the SSE `Tri4` test and the same
 //! choice among lanes. Bunny, 20 000 rays a workload, callgrind: primary 19.38M → 18.66M
 //! instructions, shadow 9.92M → 9.73M; timed, hair shadow rays 0.80 → 0.93× embree-medium
 //! and soup and grass 3–5 % faster (this VM, 2026-11-21).
@@ -9,24 +9,24 @@ use raybench_geom::tri4::nearest_lane;
 use raybench_geom::{Tri4, TriHit};
 use std::arch::x86_64::*;
 
-/// A leaf's packets two at a time, one 8-lane pass per pair (a last odd packet alone, its upper
-/// lanes zero), with [`crate::wide::kernels::intersect_packets`]'s answers: the same arithmetic lane for
+/// A leaf's `Tri4`s two at a time, one 8-lane pass per pair (a last odd one alone, its upper
+/// lanes zero), with [`crate::wide::kernels::intersect_tri4s`]'s answers: the same arithmetic lane for
 /// lane as [`Tri4::intersect`], and the same choice among lanes, so the hit (and on an exact
-/// tie, the triangle) is the one the packet-by-packet loop reports. Leaves of two or more
-/// packets (the bunny's mean leaf holds 9.8 triangles, about three packets) take half the
+/// tie, the triangle) is the one the `Tri4`-by-`Tri4` loop reports. Leaves of two or more
+/// `Tri4`s (the bunny's mean leaf holds 9.8 triangles, about three `Tri4`s) take half the
 /// passes.
 #[target_feature(enable = "avx2")]
 #[inline]
 pub(super) fn leaf_pairs<const ANY_HIT: bool>(
     r: &Avx2Ray,
-    packets: &[Tri4],
+    tri4s: &[Tri4],
     first: usize,
     best_t: &mut f32,
     best: &mut Option<(usize, TriHit)>,
 ) -> bool {
     let mut k = 0;
-    while k < packets.len() {
-        let (a, b) = (&packets[k], packets.get(k + 1));
+    while k < tri4s.len() {
+        let (a, b) = (&tri4s[k], tri4s.get(k + 1));
         if let Some((lane, h)) = test8(r, a, b, *best_t) {
             *best_t = h.t;
             *best = Some((4 * (first + k) + lane, h));
@@ -112,7 +112,7 @@ fn scaled(x: __m256, inv: __m256) -> [f32; 8] {
     out
 }
 
-/// [`Tri4::intersect`] for two packets in one pass: the answer of testing `a` and then `b`
+/// [`Tri4::intersect`] for two `Tri4`s in one pass: the answer of testing `a` and then `b`
 /// with the window shrunk to `a`'s hit, as a lane `0..8` (4.. for `b`) and its hit.
 #[target_feature(enable = "avx2")]
 #[inline]
@@ -154,7 +154,7 @@ fn test8(r: &Avx2Ray, a: &Tri4, b: Option<&Tri4>, t_max: f32) -> Option<(usize, 
     if let Some(i) = pick
         && later != 0
     {
-        // `b` is tested with the window shrunk to `a`'s hit, as the packet loop would.
+        // `b` is tested with the window shrunk to `a`'s hit, as the `Tri4` loop would.
         later &= in_window8(t, abs_den, r.t_min, tt[i]);
     }
     if later != 0 {
@@ -177,7 +177,7 @@ fn test8(r: &Avx2Ray, a: &Tri4, b: Option<&Tri4>, t_max: f32) -> Option<(usize, 
 mod tests {
     use super::super::{Avx2Nodes, splat_ray};
     use super::*;
-    use crate::wide::kernels::intersect_packets;
+    use crate::wide::kernels::intersect_tri4s;
     use raybench_geom::{MollerTriangle, Ray, Triangle, Vec3};
 
     type Answer = (bool, u32, Option<(usize, u32, u32, u32)>);
@@ -188,12 +188,12 @@ mod tests {
         (stop, best_t.to_bits(), hit)
     }
 
-    /// Pairs of packets in one 8-lane pass answer exactly as the packet-by-packet loop: the
+    /// Pairs of `Tri4`s in one 8-lane pass answer exactly as the `Tri4`-by-`Tri4` loop: the
     /// same hit, distance and barycentrics bit for bit, and on exact ties (a triangle repeated
-    /// in a later packet) the same lane, for leaves of one to five packets, closest and any
+    /// in a later `Tri4`) the same lane, for leaves of one to five `Tri4`s, closest and any
     /// hit, with a best distance carried in from earlier leaves.
     #[test]
-    fn pairs_answer_as_the_packet_loop() {
+    fn pairs_answer_as_the_tri4_loop() {
         let Some(_) = Avx2Nodes::detect(false) else {
             eprintln!("no AVX2 on this CPU: the pair test has nothing to check");
             return;
@@ -201,10 +201,10 @@ mod tests {
         let mut rng = raybench_geom::SplitMix64::new(0x1eaf);
         let (mut hits, mut ties) = (0, 0);
         for case in 0..20_000usize {
-            let packets_used = 1 + case % 5;
+            let tri4s_used = 1 + case % 5;
             let mut tris: Vec<MollerTriangle> = Vec::new();
-            for k in 0..packets_used * 4 - case % 4 {
-                // Every third case repeats earlier triangles in later packets: exact ties.
+            for k in 0..tri4s_used * 4 - case % 4 {
+                // Every third case repeats earlier triangles in later `Tri4`s: exact ties.
                 let t = if case % 3 == 0 && k >= 4 && k % 2 == 0 {
                     tris[k % 4]
                 } else {
@@ -216,7 +216,7 @@ mod tests {
                 };
                 tris.push(t);
             }
-            let packets: Vec<Tri4> = tris
+            let tri4s: Vec<Tri4> = tris
                 .chunks(4)
                 .map(|c| {
                     let ids: Vec<(u32, MollerTriangle)> = c.iter().map(|t| (7, *t)).collect();
@@ -239,9 +239,9 @@ mod tests {
             let run_loop = |any: bool| {
                 let (mut t, mut best) = (carried, None);
                 let stop = if any {
-                    intersect_packets::<true>(&packets, first, &ray, &mut t, &mut best)
+                    intersect_tri4s::<true>(&tri4s, first, &ray, &mut t, &mut best)
                 } else {
-                    intersect_packets::<false>(&packets, first, &ray, &mut t, &mut best)
+                    intersect_tri4s::<false>(&tri4s, first, &ray, &mut t, &mut best)
                 };
                 answer(stop, t, best)
             };
@@ -250,9 +250,9 @@ mod tests {
                 // SAFETY: `detect` saw AVX2 above.
                 let stop = unsafe {
                     if any {
-                        leaf_pairs::<true>(&wide, &packets, first, &mut t, &mut best)
+                        leaf_pairs::<true>(&wide, &tri4s, first, &mut t, &mut best)
                     } else {
-                        leaf_pairs::<false>(&wide, &packets, first, &mut t, &mut best)
+                        leaf_pairs::<false>(&wide, &tri4s, first, &mut t, &mut best)
                     }
                 };
                 answer(stop, t, best)
@@ -266,23 +266,23 @@ mod tests {
         }
         assert!(
             hits > 2_000 && ties > 100,
-            "{hits} hits, {ties} in later packets"
+            "{hits} hits, {ties} in later Tri4s"
         );
     }
 
     #[test]
-    fn a_lone_packet_leaves_the_upper_lanes_empty() {
+    fn a_lone_tri4_leaves_the_upper_lanes_empty() {
         let Some(_) = Avx2Nodes::detect(false) else {
             return;
         };
         let tri = MollerTriangle::new(&Triangle::new(Vec3::X, Vec3::Y, Vec3::Z));
-        let packet = Tri4::pack(&[(3, tri)]);
+        let tri4 = Tri4::pack(&[(3, tri)]);
         let ray = Ray::new(Vec3::ZERO, Vec3::ONE, 0.0, f32::INFINITY);
         // SAFETY: `detect` saw AVX2 above.
-        let hit = unsafe { test8(&splat_ray(&ray), &packet, None, f32::INFINITY) };
+        let hit = unsafe { test8(&splat_ray(&ray), &tri4, None, f32::INFINITY) };
         assert_eq!(hit.map(|(lane, _)| lane), Some(0));
         let miss = Ray::new(Vec3::splat(5.0), Vec3::ONE, 0.0, f32::INFINITY);
         // SAFETY: as above.
-        assert!(unsafe { test8(&splat_ray(&miss), &packet, None, f32::INFINITY) }.is_none());
+        assert!(unsafe { test8(&splat_ray(&miss), &tri4, None, f32::INFINITY) }.is_none());
     }
 }

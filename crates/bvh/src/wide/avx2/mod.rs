@@ -1,5 +1,5 @@
 //! The AVX2 kernels of the wide BVHs, chosen at run time: the 8-wide node test in one pass of
-//! 8-lane arithmetic per axis, and leaves tested two packets a pass.
+//! 8-lane arithmetic per axis, and leaves tested two `Tri4`s a pass.
 //!
 //! The SSE kernel ([`super::kernels::SseNodes`]) needs two 4-lane passes per axis for an 8-wide
 //! node; AVX2 does the same arithmetic in one, lane for lane: `max`/`min` keep the accumulator
@@ -147,13 +147,13 @@ impl<const W: usize> NodeKernel<W> for Avx2Nodes {
     fn leaf<const ANY_HIT: bool>(
         self,
         ray: &Avx2Ray,
-        packets: &[Tri4],
+        tri4s: &[Tri4],
         first: usize,
         best_t: &mut f32,
         best: &mut Option<(usize, TriHit)>,
     ) -> bool {
         // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.
-        unsafe { leaf_pairs::<ANY_HIT>(ray, packets, first, best_t, best) }
+        unsafe { leaf_pairs::<ANY_HIT>(ray, tri4s, first, best_t, best) }
     }
 }
 
