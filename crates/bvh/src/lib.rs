@@ -44,10 +44,9 @@ pub enum Builder {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BvhParams {
     pub builder: Builder,
-    /// Bins per axis for the binned builder (at most; see `triangles_per_bin`). 32:
-    /// measured against 8 and 16 on the bunny, Sponza, conference and dragon (1 thread,
-    /// 2026-11-21): relative to 16 bins, 8 raised the SAH cost by 1.3–4.0 % and 32 lowered it
-    /// by 0.04–4.7 % (conference the most) for 1.03–1.08× the build time.
+    /// Bins per axis for the binned builder (at most; see `triangles_per_bin`). 32: a lower
+    /// SAH cost than 8 or 16 for a few percent more build time (measured: see
+    /// docs/experiments.md, "32 bins, against 8 and 16").
     pub bins: u32,
     /// A node gets one bin per this many triangles (at least 2, at most `bins`): 1 gives a small
     /// node a candidate between every two centroids.
@@ -80,7 +79,7 @@ impl Default for BvhParams {
 }
 
 impl BvhParams {
-    /// 8 GiB: a third of this VM's memory, as the grid and octree use.
+    /// 8 GiB, as the grid and octree use: a third of the project machine's memory.
     pub const MEMORY_LIMIT: u64 = 8 << 30;
 
     pub fn binned() -> BvhParams {

@@ -4,7 +4,7 @@
 //! so no run-time detection is needed); elsewhere a portable version with the same semantics,
 //! lane for lane, so both pass the same conformance tests. The semantics that matter:
 //! [`F4::max_keep`] returns its second operand when either is NaN (`maxps`), which is how the
-//! slab test ignores the `0 * inf` of a ray lying in a box's face plane (bug class B1).
+//! slab test ignores the `0 * inf` of a ray lying in a box's face plane (docs/validation.md, B1).
 
 #[cfg(target_arch = "x86_64")]
 mod imp {

@@ -8,7 +8,7 @@ use raybench_geom::{MollerTriangle, Ray, TriHit};
 /// What the slab test needs of a ray, with each axis's near/far plane choice made once.
 struct SlabRay {
     /// Per axis, 1 when the direction's sign bit is set (so -0, whose inverse is -inf, counts
-    /// as negative: bug class B3): the index of the near plane in a box `[min, max]`, and
+    /// as negative: docs/validation.md, B3): the index of the near plane in a box `[min, max]`, and
     /// `1 - near` the far one.
     near: [usize; 3],
     /// The same ray in SIMD lanes for [`SlabRay::enter_children`]: the origin splatted, and

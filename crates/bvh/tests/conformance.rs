@@ -461,12 +461,13 @@ fn packets_against_single_rays<const W: usize>(
     (hits, ties)
 }
 
-/// Camera rays in scanline order, as the `primary` workload makes them, on scenes of every
-/// kind and from views whose rays point into several octants (an eye inside the scene looking
-/// along an axis, so the image crosses the other two axes' planes): the packet walk answers
-/// every ray as the single-ray walk does, bit for bit, except on exact ties between two
-/// triangles (19,680 of the 20,049 rays from inside the city, which meet pairs of coincident
-/// faces there; 20 of 20,000 elsewhere, with leaves of at most 8 triangles). Returns without checking (and says so) on a CPU without AVX-512F.
+/// Camera rays in scanline order, as the `primary` workload makes them, on scenes of every kind and
+/// from views whose rays point into several octants (an eye inside the scene looking along an axis,
+/// so the image crosses the other two axes' planes): the packet walk answers every ray as the
+/// single-ray walk does, bit for bit, except on exact ties between two triangles (19,680 of the
+/// 20,049 rays from inside the city, which meet pairs of coincident faces there; 20 of 20,000
+/// elsewhere, with leaves of at most 8 triangles). Returns without checking (and says so) on a CPU
+/// without AVX-512F.
 #[test]
 fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
     use raybench_accel::{Accel, PreparedRays};

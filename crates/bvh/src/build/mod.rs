@@ -16,8 +16,9 @@
 //!
 //! Shape of the build: ranges above `parallel_threshold` are split on two rayon tasks
 //! ([`Part::Split`]); each range at or below it is built sequentially straight into its own
-//! depth-first node vector ([`Part::Local`]), all its nodes sharing one [`split::Scratch`]. Flattening then copies every node exactly once,
-//! relocating child indices — no node is boxed or allocated on its own.
+//! depth-first node vector ([`Part::Local`]), all its nodes sharing one [`split::Scratch`].
+//! Flattening then copies every node exactly once, relocating child indices — no node is boxed or
+//! allocated on its own.
 
 mod prim;
 mod split;

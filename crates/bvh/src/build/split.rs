@@ -10,8 +10,8 @@ use glam::{BVec3A, Vec3A};
 use rayon::prelude::*;
 
 /// Binning passes, and the centroid passes after a partition, over at least this many
-/// triangles run on rayon (measured on the dragon: below ~64k the fork-join overhead outweighs
-/// the pass).
+/// triangles run on rayon: below that the fork-join overhead outweighs the pass (measured: see
+/// docs/experiments.md, "parallel binning passes only from 65,536 records").
 pub(crate) const PARALLEL_BINNING: usize = 65_536;
 
 /// Upper bound of the `bins` knob: bins live in fixed arrays, one set per sequential task that
@@ -65,7 +65,8 @@ fn worth_splitting(p: &BvhParams, n: usize, best_cost: f64) -> bool {
 }
 
 /// Whether no split of `n` triangles can be worth taking, whatever the split: when they fit
-/// in a leaf that costs no more than one node step (with the wide tree's knobs, up to one `Tri4`), since a split's cost is at least the traversal cost. Such a range becomes a leaf
+/// in a leaf that costs no more than one node step (with the wide tree's knobs, up to one
+/// `Tri4`), since a split's cost is at least the traversal cost. Such a range becomes a leaf
 /// without binning.
 pub(crate) fn leaf_beats_any_split(p: &BvhParams, n: usize) -> bool {
     n <= p.max_leaf_size as usize
@@ -169,8 +170,8 @@ impl Binner {
         }
     }
 
-    /// Clamped: the largest centroid would land one past the last bin (bug class B10). The
-    /// lanes lie in `[0, bins]` (centroids are inside the centroid box), so one SIMD truncation
+    /// Clamped: the largest centroid would land one past the last bin (docs/validation.md, B10).
+    /// The lanes lie in `[0, bins]` (centroids are inside the centroid box), so one SIMD truncation
     /// converts all three: Rust's saturating `as usize` per lane was a quarter of the build.
     #[inline(always)]
     fn bins_of(&self, c: Vec3A) -> [i32; 4] {
@@ -224,9 +225,8 @@ const PAIRED_FILL: usize = 256;
 
 /// Per bin and axis: the box of the triangles whose centroid falls in it, and their number.
 /// 7 KiB at [`MAX_BINS`], so there is one per sequential task (in its [`Scratch`]), and a node
-/// resets only the bins it uses. Fresh arrays per node (sized to the smallest of 8, 16, 32 or
-/// 64 bins that held the node's, built with `array::from_fn`) went through a stack temporary
-/// and `memcpy`: 14 % of the dragon's `leaf_block` 4 build (this VM, 2026-11-21).
+/// resets only the bins it uses: fresh arrays per node go through a stack temporary and a
+/// `memcpy` (measured: see docs/experiments.md, "bins in per-task scratch").
 #[derive(Clone, Copy)]
 struct Bins {
     boxes: [[Box3; 3]; MAX_BINS],
@@ -285,9 +285,9 @@ impl Scratch {
 /// Half the areas of one box per axis (`boxes[axis]`), one lane each, with coordinates scaled
 /// by `norm`. The sweep runs in f32, three axes a pass: with `norm` the inverse of the node's
 /// largest extent every extent is at most 1, so the areas weighted by triangle counts (up to
-/// 2^30) cannot overflow whatever the mesh's scale. The f64 sweep this replaced, one axis at a
-/// time, was with the choice of boundary 29 % of the 8-wide build's samples on the dragon
-/// (perf, 2 threads, this VM, 2026-11-22); the trees are the same but for rare near-ties.
+/// 2^30) cannot overflow whatever the mesh's scale. An f64 sweep, one axis at a time, gives the
+/// same trees but for rare near-ties and costs more (measured: see docs/experiments.md, "SAH
+/// sweep over the bins in f32").
 #[inline(always)]
 fn half_areas(boxes: &[Box3; 3], norm: f32) -> Vec3A {
     let e = boxes.map(|b| b.extent() * norm);
@@ -299,8 +299,8 @@ fn half_areas(boxes: &[Box3; 3], norm: f32) -> Vec3A {
 
 /// The bins of a node of `n` triangles: one per `triangles_per_bin` triangles, at least 2 and
 /// at most the `bins` knob. With one bin per triangle a small node's split candidates are all
-/// covered, but the per-node cost of evaluating 3 × bins boundaries dominated small subtrees
-/// (callgrind on the bunny: 70 % of build instructions with 16 bins everywhere).
+/// covered, but the per-node cost of evaluating 3 × bins boundaries dominates small subtrees
+/// (measured: see docs/experiments.md, "bins sized to the node").
 fn bins_for(p: &BvhParams, n: usize) -> usize {
     (n / p.triangles_per_bin.max(1) as usize)
         .max(2)
@@ -406,8 +406,8 @@ pub(crate) fn binned_split(
     let (lo, scale, limit) = (binner.min[axis], binner.scale[axis], boundary as f32);
     let mid = left_count as usize;
     // One loop per axis, so the lane is fixed inside it: with the axis a run-time index,
-    // picking the lane was a branch per record, 15 % of `decide`'s samples (perf on the
-    // dragon, 2 threads, this VM, 2026-11-22).
+    // picking the lane is a branch per record (measured: see docs/experiments.md, "the
+    // partition loop written once per axis").
     let goes_left = |c: f32| (c - lo) * scale < limit;
     match axis {
         0 => partition(refs, mid, |p| goes_left(p.centroid2_on(0))),
@@ -441,9 +441,8 @@ const BLOCK: usize = 64;
 /// front that must leave `..mid` swaps with the k-th record from the back that must leave
 /// `mid..`. But instead of a branch per record, which mispredicts on a random mix of sides,
 /// each cursor scans a block without branches, noting the positions of the misplaced records
-/// (as in Edelkamp and Weiß 2016, "BlockQuicksort"), and then the noted pairs swap. Together
-/// with taking the children's boxes from the bins, this made the dragon's `leaf_block` 4
-/// build 12 % faster (this VM, 2026-11-21).
+/// (as in Edelkamp and Weiß 2016, "BlockQuicksort"), and then the noted pairs swap (measured:
+/// see docs/experiments.md, "branch-free block partition").
 fn partition(refs: &mut [PrimRef], mid: usize, goes_left: impl Fn(&PrimRef) -> bool) {
     let n = refs.len();
     // Misplaced records in `..mid` (ascending) and in `mid..` (descending), noted but not

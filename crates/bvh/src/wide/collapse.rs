@@ -17,7 +17,8 @@ pub(super) struct Binary<'a> {
 /// Leaves of more triangles than this (one `Tri4`) may be split to fill a node's empty slots.
 const SPLIT_LEAVES_ABOVE: u32 = 4;
 
-/// Subtrees of at least this many triangles collapse their children's subtrees on rayon.
+/// Subtrees of at least this many triangles collapse their children's subtrees on rayon
+/// (measured: see docs/experiments.md, "collapse on rayon").
 const PARALLEL_COLLAPSE: usize = 4096;
 
 impl Binary<'_> {
@@ -111,8 +112,9 @@ impl Binary<'_> {
 /// Splits a leaf's triangles `refs` (the first of them record `first`) in two, forced (as
 /// Embree's wide builder splits every child of more than one block until the node is full):
 /// sorted by centroid on the axis where the centroids spread most, cut where `area × Tri4s`
-/// summed over both halves is least (first on ties). One axis, not three: three sorts made the
-/// collapse about a third slower on the bunny for the same speed. Ties in the sort go by mesh
+/// summed over both halves is least (first on ties). One axis, not three: three sorts cost about a
+/// third more build time for the same trace speed (measured: see docs/experiments.md, "the
+/// leaf split along the best of three axes"). Ties in the sort go by mesh
 /// index (deterministic).
 fn split_leaf(refs: &mut [PrimRef], first: u32) -> [(ChildRef, Aabb); 2] {
     let spread = refs

@@ -4,10 +4,10 @@ use super::node::{WideNode, quad};
 use crate::simd::F4;
 use raybench_geom::{Ray, Tri4, TriHit};
 
-/// One wide-node slab test: entry distances of all 8 children and the mask of those entered
+/// One wide-node slab test: entry distances of all `W` children and the mask of those entered
 /// within `[t_min, t_max]`. Implementations compute the scalar slab test's arithmetic lane for
 /// lane, so every kernel answers alike; a NaN (`0 * inf`, a ray in a box's face plane) is
-/// ignored because the `max`/`min` keep the accumulator (bug class B1).
+/// ignored because the `max`/`min` keep the accumulator (docs/validation.md, B1).
 pub(crate) trait NodeKernel<const W: usize>: Copy {
     type Ray;
     fn ray(self, ray: &Ray) -> Self::Ray;
@@ -47,7 +47,7 @@ impl<const W: usize> NodeKernel<W> for SseNodes {
         let inv = ray.inv_dir().to_array();
         WideRay {
             inv: inv.map(F4::splat),
-            // -0 counts as negative: its inverse is -inf (bug class B3).
+            // -0 counts as negative: its inverse is -inf (docs/validation.md, B3).
             near: inv.map(|x| x.is_sign_negative()),
             origin: ray.origin().to_array().map(F4::splat),
             ray: *ray,

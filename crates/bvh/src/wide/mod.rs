@@ -1,33 +1,34 @@
 //! Wide BVHs — 8 children per node ([`Bvh8`]) or 4 ([`Bvh4`]) — collapsed from the binary SAH
-//! tree, traversed with one SIMD box test per node (issue 8; see the README for where they
-//! stand against Embree).
+//! tree, traversed with one SIMD box test per node (see docs/results/ for where they stand
+//! against Embree).
 //!
-//! Collapse (as in Wald et al. 2008, "Getting rid of packets", and Embree's BVH4/BVH8
-//! builders): each wide node starts from a binary node's two children and repeatedly opens the
-//! child with the largest surface area — the one a ray is most likely to enter — until it has
-//! `W` children or only leaves remain; slots still empty then are filled by splitting the
-//! largest leaves of more than one `Tri4` in two (`fill_slots`, as Embree's builder splits
-//! every child until the node is full: over the 17 default scenes shadow rays +2.3–2.8 %,
-//! primary −0.1 to +1.0 %, random +0.4–0.9 % in three sweeps, and the SAH cost with the
-//! shared constants 10–35 % lower, this VM, 2026-11-21). The
-//! wide tree has about a third (8 wide) or half (4 wide) of the binary tree's depth, so a ray
-//! walks fewer, wider nodes: fewer dependent memory fetches. The trade-off between the widths:
-//! a 4-wide node is two cache lines and one 4-lane SSE test per axis, an 8-wide node four
-//! lines and one 8-lane AVX2 test, and fewer of them on a ray's path.
+//! Collapse (`collapse.rs`; as in Wald et al. 2008, "Getting rid of packets", and Embree's
+//! BVH4/BVH8 builders): each wide node starts from a binary node's two children and repeatedly
+//! opens the child with the largest surface area — the one a ray is most likely to enter —
+//! until it has `W` children or only leaves remain; slots still empty are then filled by
+//! splitting the largest leaves of more than one `Tri4` in two (`fill_slots`, as Embree's
+//! builder splits every child until the node is full). The wide tree has about a third (8
+//! wide) or half (4 wide) of the binary tree's depth, so a ray walks fewer, wider nodes: fewer
+//! dependent memory fetches. The trade-off between the widths: a 4-wide node is two cache
+//! lines and one 4-lane SSE test per axis, an 8-wide node four lines and one 8-lane AVX2 test,
+//! and fewer of them on a ray's path.
 //!
-//! Traversal is ordered: the children a ray enters are sorted by entry distance, the farther
-//! ones pushed with that distance and skipped when popped beyond the closest hit. Every child
-//! entered is prefetched before the ordering, so the fetch of the subtrees pushed for later
-//! overlaps the walk below the nearest (bunny random rays 0.97× → 1.11× embree-medium, this VM,
-//! 2026-11-21; prefetching only the pushed ones gained less).
+//! Traversal (`walk.rs`) is ordered: the children a ray enters are sorted by entry distance,
+//! the farther ones pushed with that distance and skipped when popped beyond the closest hit.
+//! Every child entered is prefetched before the ordering, so the fetch of the subtrees pushed
+//! for later overlaps the walk below the nearest.
 //!
-//! Leaves are [`Tri4`]s: the binary builder prices a leaf by the `Tri4`s of four triangles
-//! it fills (`leaf_block = 4`), and one SSE Möller–Trumbore test answers for four triangles;
-//! with AVX2 a leaf's `Tri4`s are tested two at a time, eight lanes a pass
-//! ([`avx2`]), with the same answers.
-//! An 8-wide node is tested in one 8-lane AVX2 pass per axis when the CPU has AVX2 (detected
-//! at build time, [`avx2`]) and in two 4-lane SSE passes otherwise; both are the scalar
-//! slab test lane for lane and pass the same conformance tests.
+//! Leaves are [`Tri4`]s (`pack.rs`): the binary builder prices a leaf by the `Tri4`s it fills
+//! (`leaf_block = 4`), and one SSE Möller–Trumbore test answers for four triangles; with AVX2
+//! a leaf's `Tri4`s are tested two at a time, eight lanes a pass (`avx2/`), with the same
+//! answers. An 8-wide node is tested in one 8-lane AVX2 pass per axis when the CPU has AVX2
+//! (detected at build time) and in two 4-lane SSE passes otherwise (`kernels.rs`); every
+//! kernel is the scalar slab test lane for lane and passes the same conformance tests.
+//! Coherent batches may be traced sixteen rays a packet (`packets.rs`).
+//!
+//! Caveat: the collapse only regroups the binary builder's partitions (and splits leaves), so
+//! the wide tree is as good as the binary SAH build under it; and the knobs
+//! ([`WideParams::default`]) are tuned for the 8-wide AVX2 walk on the project machine.
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;

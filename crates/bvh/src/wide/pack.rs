@@ -15,9 +15,9 @@ pub(super) struct Tri4Source {
 /// The `Tri4`s in tree order (see [`number_tri4s`]), built on rayon: gathering each
 /// triangle's vertices from the mesh is the part of the collapse that touches memory at
 /// random, and `Tri4`s are independent. The length is known, so the indexed `collect` writes
-/// each `Tri4` straight into its place (a `flat_map` over leaves collected through per-task
-/// lists and a final copy: about 7 % of the 8-wide build's samples on the sphere, perf with 2
-/// threads, this VM, 2026-11-22). The result does not depend on the thread count.
+/// each `Tri4` straight into its place, with no per-task lists and final copy (measured: see
+/// docs/experiments.md, "`Tri4`s built by an indexed parallel `collect`"). The result does not
+/// depend on the thread count.
 pub(super) fn fill_tri4s(
     mesh: &TriangleMesh,
     refs: &[PrimRef],

@@ -1,22 +1,22 @@
 //! Packets of sixteen coherent rays walked through a wide BVH together, one ray per
 //! AVX-512 lane: for camera rays in scanline order, which enter the same nodes and leaves.
 //!
-//! A single-ray walk is a chain of dependent steps: each node's test waits for the child the
-//! test before it chose (the README measures about 45 cycles a step on the bunny's primary
-//! rays). A packet turns that chain into independent work: at each node, every child's box is
-//! tested against all sixteen rays (one broadcast plane against sixteen origins), and at each
-//! leaf every triangle against all sixteen. The visits are shared, so the per-ray cost is the
-//! packet's cost divided by how many rays needed it: low for a packet whose rays hit one
-//! surface, high where they scatter (silhouettes, triangles smaller than the spacing of the
-//! rays), since a test costs the same for one lane as for sixteen. This is the classic packet
-//! traversal of Wald, Slusallek, Benthin and Wagner (2001), on a BVH as in Wald, Boulos and
+//! A single-ray walk is a chain of dependent steps: each node's test waits for the child the test
+//! before it chose (about 45 cycles a step on the bunny's primary rays: docs/experiments.md,
+//! "Profiles behind the tables"). A packet turns that chain into independent work: at each node,
+//! every child's box is tested against all sixteen rays (one broadcast plane against sixteen
+//! origins), and at each leaf every triangle against all sixteen. The visits are shared, so the
+//! per-ray cost is the packet's cost divided by how many rays needed it: low for a packet whose
+//! rays hit one surface, high where they scatter (silhouettes, triangles smaller than the spacing
+//! of the rays), since a test costs the same for one lane as for sixteen. This is the classic
+//! packet traversal of Wald, Slusallek, Benthin and Wagner (2001), on a BVH as in Wald, Boulos and
 //! Shirley (2007, "Ray tracing deformable scenes using dynamic bounding volume hierarchies"),
 //! without their frustum culling. Trade-off, measured over the default suite's primary rays
-//! (README, "Packets for coherent rays"): 1.5–2.8× the single-ray walk on scenes of large
-//! triangles (Sponza, the teapots, Sibenik), nothing or up to a quarter lost where triangles
-//! are smaller than the rays' spacing (the stadium from afar, San Francisco). Handing sparse
-//! subtrees or leaves back to the single-ray walk, as Embree's hybrid traversal does, did not
-//! measurably help here.
+//! (docs/results/): 1.5–2.8× the single-ray walk on scenes of large triangles (Sponza, the teapots,
+//! Sibenik), nothing or up to a quarter lost where triangles are smaller than the rays' spacing
+//! (the stadium from afar, San Francisco). Handing sparse subtrees or leaves back to the single-ray
+//! walk, as Embree's hybrid traversal does, did not measurably help (docs/experiments.md, "Packets
+//! for coherent rays").
 //!
 //! Exactness: every lane computes what the single-ray walk computes for its ray, operation for
 //! operation — the slab test with the near planes chosen by the direction's signs

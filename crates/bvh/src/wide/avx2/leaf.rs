@@ -1,20 +1,18 @@
-//! Leaves get the same treatment: two [`Tri4`]s in one 8-lane Möller–Trumbore pass
-//! ([`leaf_pairs`]), the same operations lane for lane as the SSE `Tri4` test and the same
-//! choice among lanes. Bunny, 20 000 rays a workload, callgrind: primary 19.38M → 18.66M
-//! instructions, shadow 9.92M → 9.73M; timed, hair shadow rays 0.80 → 0.93× embree-medium
-//! and soup and grass 3–5 % faster (this VM, 2026-11-21).
+//! The AVX2 leaf test: two [`Tri4`]s in one 8-lane Möller–Trumbore pass ([`leaf_pairs`]), the
+//! same operations lane for lane as the SSE `Tri4` test and the same choice among lanes, so
+//! the same answers in half the passes (measured: see docs/experiments.md, "AVX2 leaves: two
+//! `Tri4`s in one 8-lane pass").
 
 use super::Avx2Ray;
 use raybench_geom::tri4::nearest_lane;
 use raybench_geom::{Tri4, TriHit};
 use std::arch::x86_64::*;
 
-/// A leaf's `Tri4`s two at a time, one 8-lane pass per pair (a last odd one alone, its upper
-/// lanes zero), with [`crate::wide::kernels::intersect_tri4s`]'s answers: the same arithmetic lane for
-/// lane as [`Tri4::intersect`], and the same choice among lanes, so the hit (and on an exact
-/// tie, the triangle) is the one the `Tri4`-by-`Tri4` loop reports. Leaves of two or more
-/// `Tri4`s (the bunny's mean leaf holds 9.8 triangles, about three `Tri4`s) take half the
-/// passes.
+/// A leaf's `Tri4`s two at a time, one 8-lane pass per pair (a last odd one alone, its upper lanes
+/// zero), with [`crate::wide::kernels::intersect_tri4s`]'s answers: the same arithmetic lane for
+/// lane as [`Tri4::intersect`], and the same choice among lanes, so the hit (and on an exact tie,
+/// the triangle) is the one the `Tri4`-by-`Tri4` loop reports. Leaves of two or more `Tri4`s take
+/// half the passes.
 #[target_feature(enable = "avx2")]
 #[inline]
 pub(super) fn leaf_pairs<const ANY_HIT: bool>(

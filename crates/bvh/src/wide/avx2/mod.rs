@@ -1,20 +1,18 @@
 //! The AVX2 kernels of the wide BVHs, chosen at run time: the 8-wide node test in one pass of
-//! 8-lane arithmetic per axis, and leaves tested two `Tri4`s a pass.
+//! 8-lane arithmetic per axis, and leaves tested two `Tri4`s a pass (`leaf.rs`).
 //!
 //! The SSE kernel ([`super::kernels::SseNodes`]) needs two 4-lane passes per axis for an 8-wide
-//! node; AVX2 does the same arithmetic in one, lane for lane: `max`/`min` keep the accumulator
-//! when a lane is NaN (`0 * inf` for a ray in a box's face plane, bug class B1), the compare is
-//! ordered (false on NaN). [`Avx2Nodes`] can only be made by [`Avx2Nodes::detect`], after the
-//! CPU has reported AVX2, which is what makes calling the `#[target_feature]` code sound.
-//! AVX-512 adds no arithmetic an 8-lane f32 test needs, so there is no AVX-512 kernel. What it
-//! adds is registers: 32 vector registers instead of 16. The walk keeps ten splatted values of
-//! the ray live (origin, direction, inverse direction, `t_min`); with AVX2's sixteen, the
-//! compiler spilled them and reloaded six at every node. The batch loops are therefore
-//! compiled twice ([`batch_loops`]), once with AVX-512F and VL enabled; the same arithmetic
-//! runs in both, so the answers and counters are the same. Over the 17 scenes of the default
-//! suite, best of 10 passes interleaved with embree-medium in one process (`examples/wide.rs`,
-//! this VM's Zen 4, 2026-11-21), the AVX-512 loops against the AVX2 ones, three sweeps:
-//! primary +7.4 / +7.1 / +7.0 %, random +5.2 / +3.7 / +4.2 %, shadow +5.8 / +6.8 / +2.3 %.
+//! node; AVX2 does the same arithmetic in one, lane for lane: `max`/`min` keep the accumulator when
+//! a lane is NaN (`0 * inf` for a ray in a box's face plane, docs/validation.md, B1), the compare
+//! is ordered (false on NaN). [`Avx2Nodes`] can only be made by [`Avx2Nodes::detect`], after the
+//! CPU has reported AVX2, which is what makes calling the `#[target_feature]` code sound. AVX-512
+//! adds no arithmetic an 8-lane f32 test needs, so there is no AVX-512 kernel. What it adds is
+//! registers: 32 vector registers instead of 16. The walk keeps ten splatted values of the ray live
+//! (origin, direction, inverse direction, `t_min`); with AVX2's sixteen, the compiler spills them
+//! and reloads six at every node. The batch loops are therefore compiled twice ([`batch_loops`]),
+//! once with AVX-512F and VL enabled; the same arithmetic runs in both, so the answers and counters
+//! are the same (measured: see docs/experiments.md, "batch loops compiled a second time with
+//! AVX-512F and VL").
 
 mod leaf;
 
@@ -68,7 +66,7 @@ fn splat_ray(ray: &Ray) -> Avx2Ray {
     Avx2Ray {
         origin: origin.map(|x| _mm256_set1_ps(x)),
         inv: inv.map(|x| _mm256_set1_ps(x)),
-        // -0 counts as negative: its inverse is -inf (bug class B3).
+        // -0 counts as negative: its inverse is -inf (docs/validation.md, B3).
         near: inv.map(|x| x.is_sign_negative()),
         dir: ray.dir().to_array().map(|x| _mm256_set1_ps(x)),
         t_min: _mm256_set1_ps(ray.t_min()),
