@@ -18,7 +18,7 @@
 use crate::Bvh;
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::simd::F4;
-use crate::wide::{MAX_WIDTH, WideNode, quad};
+use crate::wide::{STACK, WideNode, quad};
 use raybench_accel::{CounterSink, Nearest, PointHit};
 use raybench_geom::Tri4;
 use raybench_geom::{Aabb, TriangleMesh, Vec3, box_distance_squared};
@@ -138,10 +138,6 @@ pub(crate) struct WideView<'a, const W: usize> {
     pub mesh: &'a TriangleMesh,
 }
 
-/// Stack entries the wide walk can need: a node pushes at most `MAX_WIDTH - 1`, one node per
-/// level, and the depth is at most [`MAX_DEPTH`].
-const WIDE_STACK: usize = (MAX_WIDTH - 1) * MAX_DEPTH + 1;
-
 /// Squared distances from the point to all children of a wide node, four at a time (unused
 /// slots hold empty boxes: infinitely far).
 #[inline(always)]
@@ -192,7 +188,8 @@ pub(crate) fn closest_point_wide<const W: usize, C: CounterSink>(
         return None;
     }
     let splat = SplatPoint::new(p);
-    let mut stack = [(ChildRef::default(), 0f32); WIDE_STACK];
+    // As deep as the ray walk's stack: a node pushes at most `MAX_WIDTH - 1`, one per level.
+    let mut stack = [(ChildRef::default(), 0f32); STACK];
     let mut sp = 0;
     let mut next = Some(bvh.root);
     let mut kids = [(ChildRef::default(), 0f32); W];

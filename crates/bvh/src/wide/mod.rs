@@ -43,7 +43,7 @@ mod stats;
 mod validate;
 mod walk;
 
-pub use node::{Node4, Node8, WideNode};
+pub use node::WideNode;
 pub use params::{NodeSimd, WideParams};
 
 pub(crate) use node::quad;

@@ -15,11 +15,8 @@ pub struct WideNode<const W: usize> {
     pub child: [ChildRef; W],
 }
 
-pub type Node8 = WideNode<8>;
-pub type Node4 = WideNode<4>;
-
-const _: () = assert!(std::mem::size_of::<Node8>() == 256);
-const _: () = assert!(std::mem::size_of::<Node4>() == 128);
+const _: () = assert!(std::mem::size_of::<WideNode<8>>() == 256);
+const _: () = assert!(std::mem::size_of::<WideNode<4>>() == 128);
 
 impl<const W: usize> WideNode<W> {
     pub(super) fn empty() -> WideNode<W> {

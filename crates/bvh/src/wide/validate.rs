@@ -21,7 +21,7 @@ impl<const W: usize> BvhWide<W> {
             return Ok(());
         }
         let (mut covered, mut interior) = (0, 0);
-        self.walk(
+        self.check_subtree(
             mesh,
             self.root,
             &self.root_bounds,
@@ -67,7 +67,7 @@ impl<const W: usize> BvhWide<W> {
         }
     }
 
-    fn walk(
+    fn check_subtree(
         &self,
         mesh: &TriangleMesh,
         r: ChildRef,
@@ -80,7 +80,7 @@ impl<const W: usize> BvhWide<W> {
             return Err(format!("depth {depth} exceeds {MAX_DEPTH}"));
         }
         if r.is_leaf() {
-            return self.walk_leaf(mesh, r, bounds, covered);
+            return self.check_leaf(mesh, r, bounds, covered);
         }
         if r.index as usize != *interior {
             return Err(format!("node {} out of depth-first order", r.index));
@@ -108,16 +108,14 @@ impl<const W: usize> BvhWide<W> {
                     r.index
                 ));
             }
-            self.walk(mesh, node.child[i], &child, depth + 1, covered, interior)?;
+            self.check_subtree(mesh, node.child[i], &child, depth + 1, covered, interior)?;
         }
         Ok(())
     }
-}
 
-impl<const W: usize> BvhWide<W> {
     /// A leaf: at the next `Tri4` in depth-first order, `count` used lanes followed by unused
     /// ones, every triangle inside the leaf's box.
-    fn walk_leaf(
+    fn check_leaf(
         &self,
         mesh: &TriangleMesh,
         r: ChildRef,
