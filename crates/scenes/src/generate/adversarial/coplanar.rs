@@ -132,10 +132,10 @@ pub(super) fn coplanar(n: u64) -> Built {
     built
 }
 
-/// The eye lies in the planes z = 0 and y = 0.25, outside the triangles (x = -3), looking along
-/// +x: every ray meets the triangles of those two planes only at its origin, t = 0, so none of
-/// them may be hit (R9 grazing rays; a traversal that rounds the plane distance to a tiny
-/// positive t reports a false hit).
+/// The eye lies in the planes z = 0 and y = 0.25, outside the triangles (x = -3), looking along +x:
+/// every ray meets the triangles of those two planes only at its origin, t = 0, so none of them may
+/// be hit (docs/validation.md, R9: grazing rays; a traversal that rounds the plane distance to a
+/// tiny positive t reports a false hit).
 fn coplanar_grazing_view() -> View {
     View {
         camera: Camera {

@@ -34,7 +34,8 @@ pub(super) fn offset_sphere(target: u64, offset: f64, radius: f64) -> Built {
         },
         light: (center + DVec3::new(2.0, 4.0, 3.0) * radius).as_vec3(),
     };
-    // From the centre, looking out through the sphere (G15: every ray must hit, no cracks).
+    // From the centre, looking out through the sphere (docs/validation.md, G15: every ray must hit,
+    // no cracks).
     let inside = View {
         camera: Camera {
             eye: center.as_vec3(),
