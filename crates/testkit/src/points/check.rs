@@ -181,6 +181,17 @@ pub fn counted_work(accel: &dyn Accel, points: &[Vec3], radius: f32) -> Counters
     c
 }
 
+/// [`check_points`] at an infinite radius, where every point must be answered, then at 0.25
+/// and at 0; panics with the first failure.
+pub fn check_points_at_radii(accel: &dyn Accel, mesh: &Arc<TriangleMesh>, points: &[Vec3]) {
+    for radius in [f32::INFINITY, 0.25, 0.0] {
+        let counts = check_points(accel, mesh, points, radius).unwrap_or_else(|e| panic!("{e}"));
+        if radius == f32::INFINITY {
+            assert_eq!(counts.answered(), points.len() as u64, "{counts:?}");
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -55,6 +55,39 @@ pub fn surface_feature_points(mesh: &TriangleMesh, max_tris: usize) -> Vec<Vec3>
         .collect()
 }
 
+/// Points exactly on the planes `first + step·i`, `i < count`, of a lattice (grid cells,
+/// octants): every crossing of three planes (in z only every `z_stride`-th plane), then 1000
+/// points uniform in `bounds` enlarged by 0.5 with one coordinate, and every other point a
+/// second one, moved onto a plane. A point on a plane lies in both closed cells around it.
+pub fn points_on_planes(
+    first: f32,
+    step: f32,
+    count: u32,
+    z_stride: usize,
+    bounds: &Aabb,
+    seed: u64,
+) -> Vec<Vec3> {
+    let plane = |i: u32| first + step * i as f32;
+    let mut points = Vec::new();
+    for z in (0..count).step_by(z_stride) {
+        for y in 0..count {
+            for x in 0..count {
+                points.push(Vec3::new(plane(x), plane(y), plane(z)));
+            }
+        }
+    }
+    let n = count as usize;
+    let random = points_in_box(&bounds.enlarged(0.5), 1000, seed);
+    for (i, mut p) in random.into_iter().enumerate() {
+        p[i % 3] = plane((i % n) as u32);
+        if i % 2 == 0 {
+            p[(i + 1) % 3] = plane((i / 3 % n) as u32);
+        }
+        points.push(p);
+    }
+    points
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -25,10 +25,10 @@ mod generate;
 
 pub use cases::{edge_point_cases, point_cases, seeded_point_cases};
 pub use check::{
-    PointCounts, PointVerdict, check_points, classify_point, counted_work, exact_distance,
-    tolerance,
+    PointCounts, PointVerdict, check_points, check_points_at_radii, classify_point, counted_work,
+    exact_distance, tolerance,
 };
-pub use generate::{points_in_box, points_near_surface, surface_feature_points};
+pub use generate::{points_in_box, points_near_surface, points_on_planes, surface_feature_points};
 
 use crate::Validator;
 use raybench_accel::Accel;
