@@ -58,12 +58,7 @@ fn scan<const ANY_HIT: bool, T, C: CounterSink>(
         if best.is_some_and(|b| h.t >= b.t) {
             continue; // equal t: keep the lower primitive index
         }
-        best = Some(Hit {
-            t: h.t,
-            prim: prim as u32,
-            u: h.u,
-            v: h.v,
-        });
+        best = Some(Hit::from_tri_hit(prim as u32, h));
         if ANY_HIT {
             break;
         }

@@ -177,11 +177,6 @@ impl Grid {
             let plane = planes[a][(cell[a] + up[a]) as usize];
             next_t[a] = max_keep(t_exit, (plane - o[a]) * inv[a]);
         }
-        best.map(|(prim, h)| Hit {
-            t: h.t,
-            prim,
-            u: h.u,
-            v: h.v,
-        })
+        best.map(|(prim, h)| Hit::from_tri_hit(prim, h))
     }
 }

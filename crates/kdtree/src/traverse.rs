@@ -144,12 +144,7 @@ impl KdTree {
                 break;
             }
         }
-        best.map(|(r, h)| Hit {
-            t: h.t,
-            prim: self.prim_ids[r as usize],
-            u: h.u,
-            v: h.v,
-        })
+        best.map(|(r, h)| Hit::from_tri_hit(self.prim_ids[r as usize], h))
     }
 }
 

@@ -21,10 +21,11 @@ use crate::node::STACK;
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::{Ray, TriHit, Vec3};
 
-/// Mailbox slots (a power of two), as the grid's: 32 ids, 128 bytes per ray, not tuned.
+/// Mailbox slots (a power of two), as the grid's: 32 ids, 128 bytes per query, not tuned.
 const MAILBOX: usize = 32;
 
-type Mailbox = raybench_accel::Mailbox<MAILBOX>;
+/// The per-query record of tested triangles, for rays and closest points alike.
+pub(crate) type Mailbox = raybench_accel::Mailbox<MAILBOX>;
 
 impl Octree {
     pub(crate) fn trace<const ANY_HIT: bool, C: CounterSink>(
@@ -126,11 +127,6 @@ impl Octree {
                 }
             }
         }
-        best.map(|(prim, h)| Hit {
-            t: h.t,
-            prim,
-            u: h.u,
-            v: h.v,
-        })
+        best.map(|(prim, h)| Hit::from_tri_hit(prim, h))
     }
 }
