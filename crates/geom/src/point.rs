@@ -105,7 +105,7 @@ pub fn box_distance_squared(p: Vec3, b: &Aabb) -> f32 {
     (b.min - p).max(p - b.max).max(Vec3::ZERO).length_squared()
 }
 
-/// Distance from `p` to `tri` in f64, for validation (testkit classifies ties with it): the
+/// Distance from `p` to `tri` in f64, for checking answers (testkit classifies ties with it): the
 /// distance to the plane when the projection of `p` falls inside the triangle, otherwise the
 /// nearest of all three edges. A different route from [`closest_point_on_triangle`] (no vertex
 /// shortcuts, no edge selection, no rounding to f32); the dense-sampling test below checks

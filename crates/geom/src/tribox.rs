@@ -15,7 +15,7 @@
 //!   face, an edge along an edge, the triangle lying in a face's plane — overlaps it. An axis
 //!   separates only when the projections are *strictly* apart (as in Akenine-Möller's
 //!   `tribox3.c`), so a triangle on a cell boundary goes into both neighbours and a ray running
-//!   along the boundary finds it from either side (reliability.md G11, B16).
+//!   along the boundary finds it from either side (docs/validation.md, G11 and B16).
 //! * **Evaluated in f64.** The f32 vertices are widened exactly; differences of f32 values are
 //!   exact in f64 and their products nearly so, so the answer is exact for practical purposes
 //!   (the tests check touching cases built on dyadic coordinates, one f32 step apart).
@@ -23,7 +23,8 @@
 //!   axis never separates them and they are placed by the box axes and the edge axes alone,
 //!   which is the exact segment–box (or point–box) test.
 //! * **NaN** makes every comparison false and is treated as separated, so a triangle with a NaN
-//!   vertex overlaps no box (never every box, which would blow up an octree, B16).
+//!   vertex overlaps no box (never every box, which would blow up an octree;
+//!   docs/validation.md, B16).
 //!
 //! Structures do not call it on the bare cell: they call it on [`conservative_box`], the cell
 //! enlarged by [`MARGIN_REL`] of its coordinates' magnitude, so that the f32 arithmetic of a

@@ -9,7 +9,7 @@
 //! `tm`. That gives up to four children with their own `[t, t']` sub-intervals, pushed farthest
 //! first. A `±0` direction component gives `tm = ±inf` (never crossed; the side follows the
 //! origin) or NaN when the origin is on the plane (the sign bit picks a side; both sides hold
-//! the plane's triangles), and the sign bit, not `< 0`, mirrors the rule (B3).
+//! the plane's triangles), and the sign bit, not `< 0`, mirrors the rule (docs/validation.md, B3).
 //!
 //! The closest hit so far is kept across leaves (a triangle straddling octants may be hit
 //! beyond the current one); a popped node starting beyond it is skipped, and the walk ends at

@@ -58,8 +58,8 @@ impl AddAssign for PointCounts {
     }
 }
 
-/// Exact distance from `p` to `tri` in f64 (geom's validation reference, a different route
-/// from the `closest_point_on_triangle` every structure uses).
+/// Exact distance from `p` to `tri` in f64 (geom's reference for checking answers, a different
+/// route from the `closest_point_on_triangle` every structure uses).
 pub fn exact_distance(p: Vec3, tri: &Triangle) -> f64 {
     distance_to_triangle_f64(p, tri)
 }

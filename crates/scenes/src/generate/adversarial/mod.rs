@@ -6,7 +6,7 @@
 //! the property under test holds in f32 after rounding (an exactly shared centroid, triangles
 //! exactly on dyadic planes, areas exactly zero), not merely "almost".
 //!
-//! | scene | for | what it is |
+//! | scene | docs/validation.md | what it is |
 //! |---|---|---|
 //! | `one-centroid` | B5, G8 | triangles of many sizes and orientations, centroid and box centre exactly the origin |
 //! | `coplanar` | B4, G9, G11, G16, R9 | axis-aligned grids on dyadic planes, exact and overlapping duplicates |
