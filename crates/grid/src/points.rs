@@ -49,9 +49,8 @@ struct Search<'c, C> {
 }
 
 impl Grid {
-    /// The nearest triangle to `p` within `max_radius` (inclusive). A point
-    /// [`Nearest::within`] rejects (non-finite, beyond Embree's range) or a negative or
-    /// NaN radius finds nothing.
+    /// [`raybench_accel::Walk::walk_point`] on the grid: shells around the point's (clamped)
+    /// cell, nearest first, until the next shell lies beyond the best triangle.
     pub(crate) fn closest<C: CounterSink>(
         &self,
         p: Vec3,

@@ -42,9 +42,8 @@ struct Search<'c, C> {
 }
 
 impl Octree {
-    /// The nearest triangle to `p` within `max_radius` (inclusive). A point
-    /// [`Nearest::within`] rejects (non-finite, beyond Embree's range) or a negative or
-    /// NaN radius finds nothing.
+    /// [`raybench_accel::Walk::walk_point`] on the octree: branch and bound from the root,
+    /// nearest octant first.
     pub(crate) fn closest<C: CounterSink>(
         &self,
         p: Vec3,
