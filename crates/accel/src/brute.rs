@@ -145,6 +145,16 @@ impl Accel for BruteForce {
     }
 }
 
+impl crate::Walk for BruteForce {
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        self.trace::<ANY_HIT, C>(ray, c)
+    }
+
+    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
+        closest_point_scan(&self.mesh, p, max_radius, c)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -266,15 +276,5 @@ mod tests {
     fn usable_as_trait_object() {
         let dynamic = crate::build_dyn::<BruteForce>(two_layers(), &Default::default()).unwrap();
         assert_eq!(dynamic.name(), "bruteforce");
-    }
-}
-
-impl crate::Walk for BruteForce {
-    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
-        self.trace::<ANY_HIT, C>(ray, c)
-    }
-
-    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
-        closest_point_scan(&self.mesh, p, max_radius, c)
     }
 }

@@ -9,7 +9,7 @@
 //! }
 //! ```
 //!
-//! Every check compares the structure with [`raybench_accel::BruteForce`] on named, seeded scenes
+//! Every check holds the structure against [`raybench_accel::BruteForce`] on named, seeded scenes
 //! and ray sets, classifying each ray with `raybench_accel::classify` and requiring zero
 //! mismatches; the structure's own `validate()` runs after every build; the counted walk must give
 //! the same answers as the timed walk; any-hit must agree with closest-hit. On failure the message

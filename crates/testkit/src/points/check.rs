@@ -131,7 +131,7 @@ pub fn classify_point(
     }
 }
 
-/// Compares `accel.closest_point` and `closest_point_counted` with brute force on every point
+/// Checks `accel.closest_point` and `closest_point_counted` against brute force on every point
 /// at `radius`. `Err` names the first failing point (with its bits, to replay it).
 pub fn check_points(
     accel: &dyn Accel,
