@@ -7,7 +7,8 @@ use raybench_geom::{Aabb, MollerTriangle, Ray};
 use raybench_scenes::{Material, Scene, Vec3, View, primary_rays};
 use std::collections::HashMap;
 
-/// Columns per patch for a target (see teapot.rs, `Tessellation`): `round(sqrt(target / 64))`.
+/// Columns per patch for a target (see generate/teapot/mod.rs, `Tessellation`): `round(sqrt(target
+/// / 64))`.
 fn teapot_columns(target: f64) -> usize {
     ((target / 64.0).sqrt().round() as usize).max(1)
 }

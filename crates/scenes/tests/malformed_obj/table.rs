@@ -278,7 +278,7 @@ pub(crate) const FIXTURES: &[Fixture] = &[
             5,
             "`@@` is not an OBJ statement (garbage or a truncated file?)",
         ),
-        why: "not a keyword: policy (scan.rs) rejects garbage, while tobj would skip it",
+        why: "not a keyword: policy (obj/scan/state.rs) rejects garbage, while tobj would skip it",
     },
     Fixture {
         file: "usemtl_without_name.obj",
