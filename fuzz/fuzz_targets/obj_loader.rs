@@ -8,7 +8,7 @@
 //! * tobj never rejects what the scan accepted (an `Obj` error without a line number);
 //! * a loaded scene has triangles, and none with a vertex Embree would drop.
 //!
-//! The same checks run on stable Rust in crates/scenes/tests/malformed_obj.rs
+//! The same checks run on stable Rust in crates/scenes/tests/malformed_obj/mutation_fuzz.rs
 //! (`mutation_fuzz_the_loader`); keep the two in step.
 #![no_main]
 

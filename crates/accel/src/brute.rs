@@ -58,12 +58,7 @@ fn scan<const ANY_HIT: bool, T, C: CounterSink>(
         if best.is_some_and(|b| h.t >= b.t) {
             continue; // equal t: keep the lower primitive index
         }
-        best = Some(Hit {
-            t: h.t,
-            prim: prim as u32,
-            u: h.u,
-            v: h.v,
-        });
+        best = Some(Hit::from_tri_hit(prim as u32, h));
         if ANY_HIT {
             break;
         }
@@ -147,6 +142,16 @@ impl Accel for BruteForce {
             primitives: bytes as u64,
             ..Memory::default()
         }
+    }
+}
+
+impl crate::Walk for BruteForce {
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        self.trace::<ANY_HIT, C>(ray, c)
+    }
+
+    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
+        closest_point_scan(&self.mesh, p, max_radius, c)
     }
 }
 
@@ -271,15 +276,5 @@ mod tests {
     fn usable_as_trait_object() {
         let dynamic = crate::build_dyn::<BruteForce>(two_layers(), &Default::default()).unwrap();
         assert_eq!(dynamic.name(), "bruteforce");
-    }
-}
-
-impl crate::Walk for BruteForce {
-    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
-        self.trace::<ANY_HIT, C>(ray, c)
-    }
-
-    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
-        closest_point_scan(&self.mesh, p, max_radius, c)
     }
 }

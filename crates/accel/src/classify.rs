@@ -1,5 +1,5 @@
-//! Deciding whether two answers for the same ray agree: the validation classes of
-//! ARCHITECTURE.md and reference/reliability.md §3.
+//! Deciding whether two answers for the same ray agree: docs/validation.md, Validation classes
+//! (the classes) and Comparison policy (why they are drawn this way).
 //!
 //! Every ray falls in exactly one [`Verdict`]. Hit/miss or different-triangle disagreements are
 //! arbitrated by recomputing, in f64, where the ray meets the disputed triangle: near an edge it
@@ -39,8 +39,9 @@ pub struct Tolerance {
 }
 
 impl Default for Tolerance {
-    /// 16 ulp is Embree's own `triangle_hit` tolerance; 64 f32 epsilons of the coordinate scale
-    /// covers Möller–Trumbore's cancellation in `U`, `V` and `T` (reliability.md §1.3, §3).
+    /// 16 ulp is Embree's own `triangle_hit` tolerance (docs/validation.md, E10); 64 f32
+    /// epsilons of the coordinate scale covers Möller–Trumbore's cancellation in `U`, `V` and
+    /// `T` (docs/validation.md, Comparison policy).
     fn default() -> Self {
         Tolerance {
             ulps: 16,
@@ -53,7 +54,8 @@ impl Tolerance {
     /// Largest acceptable |t_a - t_b| for a hit on a triangle with (unnormalised) `normal`,
     /// when the points involved have magnitude up to `scale`. A positional error `e` moves the
     /// hit along the ray by `e / |n̂·d|` in t, so grazing rays get a proportionally wider
-    /// window (reliability.md: Möller–Trumbore loses accuracy as `den` goes to 0).
+    /// window (docs/validation.md, Validation classes: Möller–Trumbore loses accuracy as `den`
+    /// goes to 0).
     pub fn t_tolerance(&self, ray: &Ray, t: f32, scale: f64, normal: Vec3) -> f64 {
         let ulp = ulp(t.abs()) as f64 * self.ulps as f64;
         let d = ray.dir().as_dvec3();

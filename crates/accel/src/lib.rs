@@ -5,7 +5,8 @@
 //! * [`Walk`] and [`walk_queries!`]: a structure writes its traversal loops once; the macro
 //!   forwards the six query methods of [`Accel`] to them.
 //! * [`BruteForce`]: the O(N) oracle every structure is checked against.
-//! * [`classify`]: the validation classes of ARCHITECTURE.md, deciding whether two answers agree.
+//! * [`classify`]: the validation classes (docs/validation.md, Validation classes), deciding
+//!   whether two answers agree.
 #![forbid(unsafe_code)]
 
 mod brute;
@@ -23,7 +24,7 @@ pub use nearest::Nearest;
 pub use raybench_geom as geom;
 pub use walk::Walk;
 
-use raybench_geom::{Ray, TriangleMesh, Vec3};
+use raybench_geom::{Ray, TriHit, TriangleMesh, Vec3};
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::collections::BTreeMap;
@@ -40,6 +41,19 @@ pub struct Hit {
     pub u: f32,
     /// Barycentric weight of the triangle's third vertex (Embree's `v`).
     pub v: f32,
+}
+
+impl Hit {
+    /// The hit `h` of a ray–triangle test, on mesh triangle `prim`.
+    #[inline(always)]
+    pub fn from_tri_hit(prim: u32, h: TriHit) -> Hit {
+        Hit {
+            t: h.t,
+            prim,
+            u: h.u,
+            v: h.v,
+        }
+    }
 }
 
 /// The answer to a closest-point query: the triangle nearest to the query point, the point on

@@ -1,8 +1,10 @@
 //! [`Nearest`]: the state of one closest-point search, shared by every structure so that all
 //! of them (and Embree's callback) accept exactly the same triangles.
 
-use crate::PointHit;
-use raybench_geom::{Triangle, Vec3, closest_point_on_triangle, query_radius_squared};
+use crate::{CounterSink, Mailbox, PointHit};
+use raybench_geom::{
+    Triangle, TriangleMesh, Vec3, closest_point_on_triangle, query_radius_squared,
+};
 
 /// The nearest triangle found so far and the squared distance that prunes the search.
 ///
@@ -56,6 +58,30 @@ impl Nearest {
     pub fn test_triangle(&mut self, p: Vec3, prim: u32, tri: &Triangle) -> bool {
         let point = closest_point_on_triangle(p, tri);
         self.offer(prim, point, point.distance_squared(p))
+    }
+
+    /// Offers every mesh triangle of `prims` that `mailbox` has not met yet in this query:
+    /// one counted point–triangle test each, and a counted mailbox skip for each one met
+    /// already. For structures that reference a triangle from several cells or leaves by its
+    /// mesh index (grid, octree); triangles are read from the mesh, as Embree's point-query
+    /// callback reads them, so the distances are brute force's.
+    #[inline(always)]
+    pub fn test_unseen<const N: usize, C: CounterSink>(
+        &mut self,
+        p: Vec3,
+        mesh: &TriangleMesh,
+        prims: &[u32],
+        mailbox: &mut Mailbox<N>,
+        c: &mut C,
+    ) {
+        for &prim in prims {
+            if mailbox.seen(prim) {
+                c.mailbox_skip();
+                continue;
+            }
+            c.prim_tests(1);
+            self.test_triangle(p, prim, &mesh.triangle(prim as usize));
+        }
     }
 
     /// True once a triangle has been kept.

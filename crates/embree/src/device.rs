@@ -257,7 +257,7 @@ mod tests {
     }
 
     /// The error callback records Embree's message and `check` reports it: REFIT is not a
-    /// valid scene build quality, which Embree reports as an error (reliability probe).
+    /// valid scene build quality, which Embree reports as an error.
     #[test]
     fn api_errors_carry_the_callback_message() {
         let device = Device::new("threads=1").unwrap();

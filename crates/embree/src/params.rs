@@ -39,7 +39,7 @@ impl Quality {
 pub struct EmbreeParams {
     pub quality: Quality,
     /// `RTC_SCENE_FLAG_ROBUST`: conservative traversal and Plücker triangle test, no cracks
-    /// along shared edges, inclusive at `t_min` (reliability.md §0.3).
+    /// along shared edges, inclusive at `t_min` (docs/validation.md, E3).
     pub robust: bool,
     /// Embree worker threads; 0 = all cores. Goes into the device config as `threads=N`.
     pub threads: usize,
@@ -185,7 +185,7 @@ mod tests {
         );
         let back: EmbreeParams = serde_json::from_str(&json).unwrap();
         assert_eq!(back, EmbreeParams::robust());
-        // Reports written before the stream knob existed still read.
+        // A report without `coherent_stream` still reads (the field defaults to false).
         let old = r#"{"quality":"medium","robust":true,"threads":0,"isa":null}"#;
         assert_eq!(
             serde_json::from_str::<EmbreeParams>(old).unwrap(),

@@ -20,8 +20,8 @@ use raybench_geom::{TriangleMesh, Vec3};
 /// A fresh point-query context, as the header's inline `rtcInitPointQueryContext` makes it (no
 /// instance on the stack). The header leaves the transform matrices uninitialised because they
 /// are undefined while the stack is empty; here they are zeroed, since Rust has no
-/// uninitialised plain values. bindgen cannot bind the function itself (it is `inline`, not an
-/// exported symbol; ecosystem.md §2.2).
+/// uninitialised plain values. bindgen cannot bind the function itself: it is an
+/// `RTC_FORCEINLINE` function of `rtcore_common.h`, and `libembree3.so` exports no such symbol.
 pub(crate) fn point_query_context() -> sys::RTCPointQueryContext {
     const LEVELS: usize = sys::RTC_MAX_INSTANCE_LEVEL_COUNT as usize;
     sys::RTCPointQueryContext {

@@ -1,4 +1,4 @@
-//! Edge cases as first-class tests (Embree's verify suite and reliability.md §1.2): empty
+//! Edge cases as first-class tests (Embree's verify suite; docs/validation.md, E4 and E8): empty
 //! mesh, one triangle, axis-parallel rays with ±0 components through a flat scene, hits exactly
 //! at t_max and t_min.
 
@@ -113,7 +113,7 @@ fn hit_exactly_at_t_max_is_a_hit() {
     }
 }
 
-/// Pins the behaviour reliability.md §1.2 measured: exactly at t_min, fast mode misses
+/// Pins the behaviour docs/validation.md, E4 records: exactly at t_min, fast mode misses
 /// (strict `t_min < t`) and robust mode hits (`t_min <= t`). If this changes, the comparison
 /// policy for robust mode must be revisited.
 #[test]

@@ -173,7 +173,7 @@ mod tests {
 
     #[test]
     fn origin_on_face_plane_with_zero_direction_is_inside() {
-        // The 0 * inf case (bug class B1): origin exactly on y = 0 and y = 1, dir.y = ±0.
+        // The 0 * inf case (docs/validation.md, B1): origin exactly on y = 0 and y = 1, dir.y = ±0.
         for y in [0.0f32, 1.0] {
             for dy in [0.0f32, -0.0] {
                 let r = Ray::infinite(Vec3::new(-1.0, y, 0.5), Vec3::new(1.0, dy, 0.0));

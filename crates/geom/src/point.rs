@@ -82,20 +82,27 @@ fn closest_point_f64(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
 fn nearest_on_edges(p: DVec3, edges: [Option<(DVec3, DVec3)>; 3]) -> DVec3 {
     let mut best = (f64::INFINITY, p);
     for (s, e) in edges.into_iter().flatten() {
-        let d = e - s;
-        let len2 = d.length_squared();
-        let t = if len2 > 0.0 {
-            ((p - s).dot(d) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let q = s + d * t;
+        let q = nearest_on_segment(p, s, e);
         let dist2 = q.distance_squared(p);
         if dist2 < best.0 {
             best = (dist2, q);
         }
     }
     best.1
+}
+
+/// The nearest point to `p` on the segment from `s` to `e` (`s` itself when the segment is a
+/// point).
+#[inline(always)]
+fn nearest_on_segment(p: DVec3, s: DVec3, e: DVec3) -> DVec3 {
+    let d = e - s;
+    let len2 = d.length_squared();
+    let t = if len2 > 0.0 {
+        ((p - s).dot(d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    s + d * t
 }
 
 /// Squared distance from `p` to the nearest point of `b` (0 inside). An empty box
@@ -105,7 +112,7 @@ pub fn box_distance_squared(p: Vec3, b: &Aabb) -> f32 {
     (b.min - p).max(p - b.max).max(Vec3::ZERO).length_squared()
 }
 
-/// Distance from `p` to `tri` in f64, for validation (testkit classifies ties with it): the
+/// Distance from `p` to `tri` in f64, for checking answers (testkit classifies ties with it): the
 /// distance to the plane when the projection of `p` falls inside the triangle, otherwise the
 /// nearest of all three edges. A different route from [`closest_point_on_triangle`] (no vertex
 /// shortcuts, no edge selection, no rounding to f32); the dense-sampling test below checks
@@ -135,14 +142,7 @@ pub fn distance_to_triangle_f64(p: Vec3, tri: &Triangle) -> f64 {
 }
 
 fn segment_distance_f64(p: DVec3, s: DVec3, e: DVec3) -> f64 {
-    let d = e - s;
-    let len2 = d.length_squared();
-    let t = if len2 > 0.0 {
-        ((p - s).dot(d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (s + d * t)).length()
+    (p - nearest_on_segment(p, s, e)).length()
 }
 
 #[cfg(test)]

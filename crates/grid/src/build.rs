@@ -2,9 +2,9 @@
 //!
 //! Resolution follows Cleary and Wyvill ("Analysis of an algorithm for fast ray tracing using
 //! uniform space subdivision", The Visual Computer 4(2), 1988): for N triangles and density λ,
-//! cells of side `s = (V / λN)^(1/k)` over the k axes with extent, so cells are as close to
-//! cubes as the bounds allow and number about λ·N; an axis thinner than one cell gets one cell
-//! and the others share the budget (a flat scene gets a 2D grid, reliability.md G9/B14), and no
+//! cells of side `s = (V / λN)^(1/k)` over the k axes with extent, so cells are as close to cubes
+//! as the bounds allow and number about λ·N; an axis thinner than one cell gets one cell and the
+//! others share the budget (a flat scene gets a 2D grid: docs/validation.md, G9 and B14), and no
 //! axis gets more than [`GridParams::max_resolution`].
 //!
 //! Insertion is exact: each triangle goes into the cells of its bounding box that pass the

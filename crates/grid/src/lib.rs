@@ -53,11 +53,9 @@ pub struct GridParams {
 }
 
 impl GridParams {
-    /// λ = 1: measured against 0.5, 1.5, 2, 3 and 4 on the bunny, grass, terrain and
-    /// conference (100k primary and 100k random rays each, 1 thread, four-lane triangle tests): the fastest or within 10 % of it on every scene and workload, and the
-    /// cheapest build of those; λ = 2 traced 4–13 % slower on the bunny, terrain and conference
-    /// (grass: 6 % faster on random rays, 6 % slower on primary); λ = 4 was 10–25 % slower
-    /// everywhere. (With one triangle tested at a time, λ = 2 was best.)
+    /// λ = 1: against 0.5, 1.5, 2, 3 and 4, the fastest or within 10 % of it on every scene
+    /// and workload, and the cheapest build of those, with triangles tested four lanes at a
+    /// time (measured: see docs/experiments.md, Uniform grid and octree).
     pub const DEFAULT_DENSITY: f64 = 1.0;
     /// λ = 1/8: "too few cells" (cells hold dozens of triangles).
     pub const COARSE_DENSITY: f64 = 0.125;

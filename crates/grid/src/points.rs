@@ -49,9 +49,8 @@ struct Search<'c, C> {
 }
 
 impl Grid {
-    /// The nearest triangle to `p` within `max_radius` (inclusive). A point
-    /// [`Nearest::within`] rejects (non-finite, beyond Embree's range) or a negative or
-    /// NaN radius finds nothing.
+    /// [`raybench_accel::Walk::walk_point`] on the grid: shells around the point's (clamped)
+    /// cell, nearest first, until the next shell lies beyond the best triangle.
     pub(crate) fn closest<C: CounterSink>(
         &self,
         p: Vec3,
@@ -221,17 +220,10 @@ impl Grid {
         if self.occupied[u >> 6] >> (u & 63) & 1 == 0 {
             return true;
         }
-        let p = s.p;
         // References are mesh triangle ids (the Tri4s keep mesh order, `build.rs`).
-        for &prim in &self.refs[self.offsets[u] as usize..self.offsets[u + 1] as usize] {
-            if s.mailbox.seen(prim) {
-                s.counters.mailbox_skip();
-                continue;
-            }
-            s.counters.prim_tests(1);
-            s.best
-                .test_triangle(p, prim, &self.mesh.triangle(prim as usize));
-        }
+        let refs = &self.refs[self.offsets[u] as usize..self.offsets[u + 1] as usize];
+        s.best
+            .test_unseen(s.p, &self.mesh, refs, &mut s.mailbox, s.counters);
         true
     }
 }

@@ -1,14 +1,14 @@
 //! The one traversal loop: Amanatides and Woo's 3D-DDA ("A Fast Voxel Traversal Algorithm for
 //! Ray Tracing", Eurographics 1987), for closest hit and any hit, counted and not.
 //!
-//! * Entry: the ray is clipped to the grid's bounds with the NaN-safe slab test, and the cell
-//!   of the entry point is found by a floor, clamped (pbrt's `posToVoxel`, B13), then corrected
-//!   against the cell planes so it is never *ahead* of the ray on an axis it moves along (that
-//!   would skip a cell); a cell behind is harmless (its exit is at once).
+//! * Entry: the ray is clipped to the grid's bounds with the NaN-safe slab test, and the cell of
+//!   the entry point is found by a floor, clamped (pbrt's `posToVoxel`; docs/validation.md, B13),
+//!   then corrected against the cell planes so it is never *ahead* of the ray on an axis it moves
+//!   along (that would skip a cell); a cell behind is harmless (its exit is at once).
 //! * Stepping: the next crossing on each axis is recomputed from the f32 cell planes at every
 //!   step, never accumulated, so long walks do not drift away from the planes insertion used.
 //!   A `±0` direction component never crosses (its crossing is `+inf`; the sign bit, not `< 0`,
-//!   picks the step, B3).
+//!   picks the step; docs/validation.md, B3).
 //! * Termination: the closest hit found so far is kept across cells (a triangle that straddles
 //!   cells may be hit beyond the current one), and the walk stops in the first cell whose exit
 //!   is at or beyond it — or at the end of the ray or of the grid. Every iteration steps one
@@ -177,11 +177,6 @@ impl Grid {
             let plane = planes[a][(cell[a] + up[a]) as usize];
             next_t[a] = max_keep(t_exit, (plane - o[a]) * inv[a]);
         }
-        best.map(|(prim, h)| Hit {
-            t: h.t,
-            prim,
-            u: h.u,
-            v: h.v,
-        })
+        best.map(|(prim, h)| Hit::from_tri_hit(prim, h))
     }
 }

@@ -181,9 +181,7 @@ mod tests {
     use std::sync::Arc;
 
     fn built() -> (Grid, Arc<raybench_geom::TriangleMesh>) {
-        let mesh = raybench_testkit::scenes::generate("soup:triangles=500", 3)
-            .unwrap()
-            .mesh;
+        let mesh = raybench_testkit::generated("soup:triangles=500", 3);
         (
             Grid::build(mesh.clone(), &GridParams::default()).unwrap(),
             mesh,

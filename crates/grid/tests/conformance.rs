@@ -2,20 +2,18 @@
 //! rays aimed at the grid's own geometry: axis-parallel, starting inside, exactly along cell
 //! planes, edges and corners.
 
-use raybench_accel::{Accel, BuildError};
+use raybench_accel::Accel;
 use raybench_geom::{Ray, TriangleMesh, Vec3};
 use raybench_grid::{Grid, GridParams};
 use raybench_testkit::points::{point_conformance, point_conformance_on_shared_scenes};
-use raybench_testkit::{Case, check_case, conformance, lattice_rays, lattice_scene};
+use raybench_testkit::{
+    check_conformance, check_lattice, expect_too_large, generated, lattice_rays, lattice_scene,
+    refused_rays,
+};
 use std::sync::Arc;
 
 fn check(params: GridParams) {
-    let counts = conformance::<Grid>(&params, &|g, mesh| g.validate(mesh));
-    assert_eq!(counts.mismatch, 0);
-    assert!(
-        counts.exact > 10_000,
-        "the suite must exercise hits: {counts:?}"
-    );
+    check_conformance::<Grid>(&params, &|g, mesh| g.validate(mesh));
 }
 
 #[test]
@@ -60,29 +58,18 @@ fn default_conforms_on_the_shared_scenes() {
 
 #[test]
 fn too_large_is_an_error_not_an_abort() {
-    let mesh = raybench_testkit::scenes::generate("soup:triangles=2000", 1)
-        .unwrap()
-        .mesh;
+    let mesh = generated("soup:triangles=2000", 1);
     let params = GridParams {
         memory_limit_bytes: 64 * 1024,
         ..GridParams::default()
     };
-    match Grid::build(mesh.clone(), &params) {
-        Err(BuildError::TooLarge {
-            needed_bytes,
-            limit_bytes,
-        }) => assert!(needed_bytes > limit_bytes),
-        other => panic!("expected TooLarge, got {other:?}"),
-    }
+    expect_too_large::<Grid>(&mesh, &params);
     // References alone over the limit (the offsets and copies fit).
     let params = GridParams {
         memory_limit_bytes: 2000 * 48 + 4 * 4100 + 12 * 1000,
         ..GridParams::with_density(2.0)
     };
-    assert!(matches!(
-        Grid::build(mesh, &params),
-        Err(BuildError::TooLarge { .. })
-    ));
+    expect_too_large::<Grid>(&mesh, &params);
 }
 
 /// The testkit's lattice scene with a grid of 8³ cells of side 0.5 (dyadic planes).
@@ -96,22 +83,13 @@ fn plane_scene() -> (Arc<TriangleMesh>, GridParams) {
 #[test]
 fn rays_along_cell_planes_edges_and_corners() {
     let (mesh, params) = plane_scene();
-    let grid = Grid::build(mesh.clone(), &params).unwrap();
+    let grid = Grid::build(mesh, &params).unwrap();
     assert_eq!(
         grid.resolution(),
         [8, 8, 8],
         "the scene must give 0.5-wide cells"
     );
-    let case = Case {
-        name: "cell-planes".into(),
-        seed: 0x5eed_6002,
-        mesh,
-        rays: lattice_rays(),
-    };
-    let counts =
-        check_case::<Grid>(&case, &params, &|g, m| g.validate(m)).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(counts.mismatch, 0);
-    assert!(counts.exact > 300, "{counts:?}");
+    check_lattice::<Grid>("cell-planes", &params, &|g, m| g.validate(m));
 }
 
 #[test]
@@ -130,12 +108,7 @@ fn walks_are_bounded_and_counted() {
     }
     assert!(total.mailbox_skips > 0, "{total:?}");
     // Invalid rays (NaN, zero direction) miss in bounded time.
-    for r in [
-        Ray::infinite(Vec3::new(f32::NAN, 1.0, 1.0), Vec3::X),
-        Ray::infinite(Vec3::splat(1.0), Vec3::new(f32::NAN, 1.0, 0.0)),
-        Ray::infinite(Vec3::splat(1.0), Vec3::ZERO),
-        Ray::new(Vec3::splat(1.0), Vec3::X, f32::NAN, f32::NAN),
-    ] {
+    for r in refused_rays() {
         let mut c = raybench_accel::Counters::default();
         let _ = grid.intersect_counted(&r, &mut c);
         assert!(c.cells <= 24, "{r:?}: {c:?}");

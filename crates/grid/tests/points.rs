@@ -4,24 +4,17 @@
 use raybench_accel::{Accel, Counters};
 use raybench_geom::{TriangleMesh, Vec3};
 use raybench_grid::{Grid, GridParams};
-use raybench_testkit::lattice_scene;
-use raybench_testkit::points::{check_points, points_in_box, points_near_surface};
+use raybench_testkit::points::{
+    check_points, check_points_at_radii, counted_work as work, points_in_box, points_near_surface,
+    points_on_planes,
+};
+use raybench_testkit::{generated, lattice_scene};
 use std::sync::Arc;
 
 const SEED: u64 = 0x5eed_7601;
 
 fn soup() -> Arc<TriangleMesh> {
-    raybench_testkit::scenes::generate("soup:triangles=3000", SEED)
-        .unwrap()
-        .mesh
-}
-
-fn work(grid: &Grid, points: &[Vec3], radius: f32) -> Counters {
-    let mut c = Counters::default();
-    for &p in points {
-        grid.closest_point_counted(p, radius, &mut c);
-    }
-    c
+    generated("soup:triangles=3000", SEED)
 }
 
 /// The lattice scene in 8³ cells of side 0.5: points on every plane, edge and corner of the
@@ -33,29 +26,8 @@ fn points_on_cell_planes_edges_and_corners() {
     let params = GridParams::with_density(512.0 / mesh.len() as f64);
     let grid = Grid::build(mesh.clone(), &params).unwrap();
     assert_eq!(grid.resolution(), [8, 8, 8]);
-    let plane = |i: u32| -0.5 + 0.5 * i as f32;
-    let mut points = Vec::new();
-    for z in (0..11).step_by(2) {
-        for y in 0..11 {
-            for x in 0..11 {
-                points.push(Vec3::new(plane(x), plane(y), plane(z)));
-            }
-        }
-    }
-    let random = points_in_box(&mesh.bounds().enlarged(0.5), 1000, SEED);
-    for (i, mut p) in random.into_iter().enumerate() {
-        p[i % 3] = plane((i % 11) as u32);
-        if i % 2 == 0 {
-            p[(i + 1) % 3] = plane((i / 3 % 11) as u32);
-        }
-        points.push(p);
-    }
-    for radius in [f32::INFINITY, 0.25, 0.0] {
-        let counts = check_points(&grid, &mesh, &points, radius).unwrap_or_else(|e| panic!("{e}"));
-        if radius == f32::INFINITY {
-            assert_eq!(counts.answered(), points.len() as u64, "{counts:?}");
-        }
-    }
+    let points = points_on_planes(-0.5, 0.5, 11, 2, &mesh.bounds(), SEED);
+    check_points_at_radii(&grid, &mesh, &points);
 }
 
 /// Near the surface, the search opens a few cells and tests a few triangles.

@@ -85,15 +85,12 @@ impl KdParams {
     /// 8 GiB: a third of this VM's memory, as the grid and octree use.
     pub const MEMORY_LIMIT: u64 = 8 << 30;
 
-    /// `kd-sah`. `K_I / K_T = 0.75`: measured with `examples/kdtune.rs` on the bunny and
-    /// Sponza (1 thread, 100k seeded random and primary rays, 2026-11-21) against 0.5, 1, 1.5
-    /// (about Wald and Havran's 20/15) and 2. With 1.5 and above the SAH splits every cell down
-    /// to the depth limit (bunny: 662k nodes, 5.5 references per triangle) and random rays were
-    /// 15–25 % slower on the bunny; 0.75 was the fastest or within noise of it on both scenes
-    /// for both workloads and builds 1.6× faster than 1.5 (bunny: 321k nodes, 3.9 references
-    /// per triangle). Our node step is a dependent load, so a test costing less than a step is
-    /// plausible. `λ = 0.8` (Wald and Havran's): no bonus (1.0) was 3–7 % slower on random rays.
-    /// `leaf_size = 0`: 1 and 2 changed nothing measurable (the cost decides).
+    /// `kd-sah`. `K_I / K_T = 0.75`, against 0.5, 1, 1.5 (about Wald and Havran's 20/15) and 2:
+    /// from 1.5 up the SAH splits every cell down to the depth limit and traces slower, while
+    /// 0.75 was the fastest or within noise and builds faster. Our node step is a dependent
+    /// load, so a test costing less than a step is plausible. `λ = 0.8` (Wald and Havran's)
+    /// against no bonus; `leaf_size = 0`, as 1 and 2 changed nothing (the cost decides).
+    /// Measured: see docs/experiments.md, k-d tree.
     pub fn sah() -> KdParams {
         KdParams {
             builder: Builder::Sah,

@@ -55,9 +55,8 @@ fn squared(o: [f32; 3]) -> f32 {
 }
 
 impl KdTree {
-    /// The nearest triangle to `p` within `max_radius` (inclusive), over both trees. A point
-    /// [`Nearest::within`] rejects (non-finite, beyond Embree's range) or a negative or
-    /// NaN radius finds nothing.
+    /// [`raybench_accel::Walk::walk_point`] over both trees: the tree rays walk, then the
+    /// zero-area side tree with the best distance so far as its radius.
     pub(crate) fn closest<C: CounterSink>(
         &self,
         p: Vec3,

@@ -43,11 +43,10 @@ use crate::node::MAX_DEPTH;
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::{Ray, TriHit, max_keep, min_keep};
 
-/// Mailbox size, a power of two. 8 slots are 32 bytes, two stores per ray; at 16 the
-/// initialisation compiled to a `memset` call (callgrind, 2026-11-21). Measured with
-/// `examples/kdtune.rs` (bunny, Sponza; 1 thread): the mailbox saves 0.1–0.2 of 1–3.5
-/// triangle tests per random ray, and on/off is within the run-to-run noise (±4 %) in time,
-/// because `kd-sah` leaves are small and a ray visits only about two non-empty leaves.
+/// Mailbox size, a power of two. 8 slots are 32 bytes, two stores per ray; 16 compile their
+/// initialisation to a `memset` call. The mailbox saves few tests, because `kd-sah` leaves are
+/// small and a ray visits only about two non-empty leaves (measured: see docs/experiments.md,
+/// k-d tree).
 pub const MAILBOX_SLOTS: usize = 8;
 
 impl KdTree {
@@ -144,12 +143,7 @@ impl KdTree {
                 break;
             }
         }
-        best.map(|(r, h)| Hit {
-            t: h.t,
-            prim: self.prim_ids[r as usize],
-            u: h.u,
-            v: h.v,
-        })
+        best.map(|(r, h)| Hit::from_tri_hit(self.prim_ids[r as usize], h))
     }
 }
 

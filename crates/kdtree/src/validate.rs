@@ -281,9 +281,7 @@ mod tests {
     use std::sync::Arc;
 
     fn built(params: KdParams) -> (KdTree, Arc<raybench_geom::TriangleMesh>) {
-        let mesh = raybench_testkit::scenes::generate("soup:triangles=500", 3)
-            .unwrap()
-            .mesh;
+        let mesh = raybench_testkit::generated("soup:triangles=500", 3);
         (KdTree::build(mesh.clone(), &params).unwrap(), mesh)
     }
 

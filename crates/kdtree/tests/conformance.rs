@@ -3,16 +3,11 @@
 //! for closest-point queries (testkit's point suite, every variant).
 
 use raybench_kdtree::{KdParams, KdTree};
-use raybench_testkit::conformance;
 use raybench_testkit::points::{point_conformance, point_conformance_on_shared_scenes};
+use raybench_testkit::{check_conformance, expect_too_large, generated};
 
 fn check(params: KdParams) {
-    let counts = conformance::<KdTree>(&params, &|kd, mesh| kd.validate(mesh));
-    assert_eq!(counts.mismatch, 0);
-    assert!(
-        counts.exact > 10_000,
-        "the suite must exercise hits: {counts:?}"
-    );
+    check_conformance::<KdTree>(&params, &|kd, mesh| kd.validate(mesh));
 }
 
 #[test]
@@ -115,21 +110,13 @@ fn point_queries_conform_on_the_shared_scenes() {
 /// the tree is still correct.
 #[test]
 fn too_large_is_an_error_not_an_abort() {
-    use raybench_accel::{Accel, BuildError};
-    let mesh = raybench_testkit::scenes::generate("soup:triangles=2000", 1)
-        .expect("generates")
-        .mesh;
+    use raybench_accel::Accel;
+    let mesh = generated("soup:triangles=2000", 1);
     let tiny = KdParams {
         memory_limit_bytes: 64 * 1024,
         ..KdParams::sah()
     };
-    match KdTree::build(mesh.clone(), &tiny) {
-        Err(BuildError::TooLarge {
-            needed_bytes,
-            limit_bytes,
-        }) => assert!(needed_bytes > limit_bytes),
-        other => panic!("expected TooLarge, got {:?}", other.map(|_| ())),
-    }
+    expect_too_large::<KdTree>(&mesh, &tiny);
     // Room for the triangles and about 1.5 references each: fewer splits, same answers.
     let tight = KdParams {
         memory_limit_bytes: 2000 * 116 + 3000 * 108,

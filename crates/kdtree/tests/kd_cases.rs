@@ -63,7 +63,7 @@ fn triangles_and_rays_in_split_planes() {
         "city:triangles=3000",
         "plane:quads=16,tilt_deg=0",
     ] {
-        let mesh = raybench_testkit::scenes::generate(spec, SEED).unwrap().mesh;
+        let mesh = raybench_testkit::generated(spec, SEED);
         for p in both_variants() {
             let kd = KdTree::build(mesh.clone(), &p).unwrap();
             let mut rays = rays_in_split_planes(&kd, 3000, SEED);
@@ -124,9 +124,7 @@ fn a_huge_triangle_over_small_ones_stays_bounded() {
 #[test]
 fn the_reference_budget_caps_duplication() {
     // 300 long thin triangles crossing each other: every split duplicates many of them.
-    let mesh = raybench_testkit::scenes::generate("hair:triangles=300,length=1", SEED)
-        .unwrap()
-        .mesh;
+    let mesh = raybench_testkit::generated("hair:triangles=300,length=1", SEED);
     let p = KdParams {
         traversal_cost: 0.0,
         empty_bonus: 1.0,
@@ -141,9 +139,7 @@ fn the_reference_budget_caps_duplication() {
 
 #[test]
 fn parallel_and_sequential_builds_make_the_same_tree() {
-    let mesh = raybench_testkit::scenes::generate("sphere:triangles=40000", SEED)
-        .unwrap()
-        .mesh;
+    let mesh = raybench_testkit::generated("sphere:triangles=40000", SEED);
     for p in both_variants() {
         let p = KdParams {
             parallel_threshold: 256,
@@ -166,9 +162,7 @@ fn parallel_and_sequential_builds_make_the_same_tree() {
 
 #[test]
 fn counters_show_early_exit_and_mailbox_skips() {
-    let mesh = raybench_testkit::scenes::generate("sphere:triangles=20000", SEED)
-        .unwrap()
-        .mesh;
+    let mesh = raybench_testkit::generated("sphere:triangles=20000", SEED);
     let kd = KdTree::build(mesh.clone(), &KdParams::sah()).unwrap();
     let no_mb = KdTree::build(
         mesh.clone(),
@@ -218,9 +212,7 @@ fn counters_show_early_exit_and_mailbox_skips() {
 #[test]
 fn mailbox_skips_happen_on_duplicated_references() {
     // Long needles crossing many cells: the same triangle is met again in later leaves.
-    let mesh = raybench_testkit::scenes::generate("hair:triangles=2000", SEED)
-        .unwrap()
-        .mesh;
+    let mesh = raybench_testkit::generated("hair:triangles=2000", SEED);
     let kd = KdTree::build(mesh.clone(), &KdParams::sah()).unwrap();
     let mut c = Counters::default();
     for r in random_rays_in(&mesh.bounds(), 2000, SEED) {

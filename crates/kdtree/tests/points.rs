@@ -5,29 +5,20 @@
 use raybench_accel::{Accel, Counters};
 use raybench_geom::{Aabb, Triangle, TriangleMesh, Vec3};
 use raybench_kdtree::{KdParams, KdTree};
-use raybench_testkit::points::{check_points, points_in_box, points_near_surface};
+use raybench_testkit::generated;
+use raybench_testkit::points::{
+    check_points, counted_work as work, points_in_box, points_near_surface,
+};
 use std::sync::Arc;
 
 const SEED: u64 = 0x5eed_7d01;
 
 fn soup(n: usize) -> Arc<TriangleMesh> {
-    let spec = format!("soup:triangles={n}");
-    raybench_testkit::scenes::generate(&spec, SEED)
-        .unwrap()
-        .mesh
+    generated(&format!("soup:triangles={n}"), SEED)
 }
 
 fn near_points(mesh: &TriangleMesh, n: usize) -> Vec<Vec3> {
     points_near_surface(mesh, n, 0.01 * mesh.bounds().diagonal(), SEED)
-}
-
-/// Total counters of `points` at `radius`.
-fn work(kd: &KdTree, points: &[Vec3], radius: f32) -> Counters {
-    let mut c = Counters::default();
-    for &p in points {
-        kd.closest_point_counted(p, radius, &mut c);
-    }
-    c
 }
 
 /// Points with one coordinate exactly on a split plane of the tree: the point is in both
@@ -35,7 +26,7 @@ fn work(kd: &KdTree, points: &[Vec3], radius: f32) -> Counters {
 #[test]
 fn points_in_split_planes() {
     for spec in ["coplanar:triangles=3000", "city:triangles=3000"] {
-        let mesh = raybench_testkit::scenes::generate(spec, SEED).unwrap().mesh;
+        let mesh = generated(spec, SEED);
         for params in [KdParams::sah(), KdParams::median()] {
             let kd = KdTree::build(mesh.clone(), &params).unwrap();
             kd.validate(&mesh).unwrap();

@@ -10,20 +10,19 @@
 //! teapot sits) — untested when its bounding box lies inside the enlarged octant, skipped when
 //! its bounding box misses it.
 //!
-//! Termination and blow-up guards (reliability.md B15, G7, G8, G10, G13): a node is also a leaf
-//! when its centre cannot be represented strictly between its faces in f32 (cells a few ulps
-//! wide); when splitting makes no progress — two octants or more would each receive all the
-//! node's triangles (identical triangles, a point, triangles meeting along an edge: the tiered
-//! stands of a stadium are full of those, and without this rule every such edge is followed
-//! down to MAX_DEPTH, its cells doubling at each level; one octant receiving everything, a
-//! teapot in one corner of the node, is progress); when no triangle is as small as an octant
-//! on two axes at least (each then crosses several octants, and splitting only follows their
-//! shared edges and corners down — at every corner of a stadium's steps where more than
-//! MAX_OBJ triangles meet); or when a surface-area cost model says the
-//! split does not pay ([`OctreeParams::traversal_cost`]: concentric or crossing triangles,
-//! where each central octant gets most of them level after level). The references and nodes
-//! in flight are counted at every split and the build stops with [`BuildError::TooLarge`] past
-//! [`OctreeParams::memory_limit_bytes`].
+//! Termination and blow-up guards (docs/validation.md, B15, G7, G8, G10 and G13): a node is also a
+//! leaf when its centre cannot be represented strictly between its faces in f32 (cells a few ulps
+//! wide); when splitting makes no progress — two octants or more would each receive all the node's
+//! triangles (identical triangles, a point, triangles meeting along an edge: the tiered stands of a
+//! stadium are full of those, and without this rule every such edge is followed down to MAX_DEPTH,
+//! its cells doubling at each level; one octant receiving everything, a teapot in one corner of the
+//! node, is progress); when no triangle is as small as an octant on two axes at least (each then
+//! crosses several octants, and splitting only follows their shared edges and corners down — at
+//! every corner of a stadium's steps where more than MAX_OBJ triangles meet); or when a
+//! surface-area cost model says the split does not pay ([`OctreeParams::traversal_cost`]:
+//! concentric or crossing triangles, where each central octant gets most of them level after
+//! level). The references and nodes in flight are counted at every split and the build stops with
+//! [`BuildError::TooLarge`] past [`OctreeParams::memory_limit_bytes`].
 //!
 //! Built as a boxed tree (large nodes split on rayon tasks), then flattened: the present
 //! children of a node contiguous, leaves' references in depth-first order.

@@ -55,13 +55,13 @@ pub struct OctreeParams {
 }
 
 impl OctreeParams {
-    /// 8: the customary value, not tuned here (issue-6 note).
+    /// 8: the customary value, not tuned.
     pub const MAX_OBJ: u32 = 8;
     /// 20: deep enough to reach the teapot's own scale in the 1 km stadium (2^-20 of the
-    /// 1 km root is 1 mm; the teapot's triangles are a few mm). Measured (1 thread, issue-6
-    /// note): the bunny, grass and terrain stop on the split rules at depth 9, 11 and 7; the
-    /// teapot in a stadium uses all 20 levels; the conference room also reaches 20 (190k
-    /// leaves there, 16.5 references per triangle — the open problem of this octree).
+    /// 1 km root is 1 mm; the teapot's triangles are a few mm). Most scenes stop on the split
+    /// rules well above it; conference reaches it too, with many references per triangle, the
+    /// open problem of this octree (measured: see docs/experiments.md, Uniform grid and
+    /// octree).
     pub const MAX_DEPTH: u32 = 20;
     /// 8 GiB.
     pub const MEMORY_LIMIT: u64 = 8 << 30;

@@ -29,13 +29,9 @@
 
 use crate::Octree;
 use crate::node::{Node, child_box};
+use crate::traverse::Mailbox;
 use raybench_accel::{CounterSink, Nearest, PointHit};
 use raybench_geom::{Vec3, box_distance_squared};
-
-/// Mailbox slots (a power of two), as the ray walk's.
-const MAILBOX: usize = 32;
-
-type Mailbox = raybench_accel::Mailbox<MAILBOX>;
 
 /// One query in flight: the point, the best so far, the mailbox and the counters.
 struct Search<'c, C> {
@@ -46,9 +42,8 @@ struct Search<'c, C> {
 }
 
 impl Octree {
-    /// The nearest triangle to `p` within `max_radius` (inclusive). A point
-    /// [`Nearest::within`] rejects (non-finite, beyond Embree's range) or a negative or
-    /// NaN radius finds nothing.
+    /// [`raybench_accel::Walk::walk_point`] on the octree: branch and bound from the root,
+    /// nearest octant first.
     pub(crate) fn closest<C: CounterSink>(
         &self,
         p: Vec3,
@@ -96,16 +91,9 @@ impl Octree {
 
     #[inline(always)]
     fn test_leaf<C: CounterSink>(&self, leaf: &Node, s: &mut Search<C>) {
-        let p = s.p;
-        for &prim in &self.refs[leaf.refs()] {
-            if s.mailbox.seen(prim) {
-                s.counters.mailbox_skip();
-                continue;
-            }
-            s.counters.prim_tests(1);
-            s.best
-                .test_triangle(p, prim, &self.mesh.triangle(prim as usize));
-        }
+        let refs = &self.refs[leaf.refs()];
+        s.best
+            .test_unseen(s.p, &self.mesh, refs, &mut s.mailbox, s.counters);
     }
 }
 

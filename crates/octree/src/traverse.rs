@@ -9,7 +9,7 @@
 //! `tm`. That gives up to four children with their own `[t, t']` sub-intervals, pushed farthest
 //! first. A `±0` direction component gives `tm = ±inf` (never crossed; the side follows the
 //! origin) or NaN when the origin is on the plane (the sign bit picks a side; both sides hold
-//! the plane's triangles), and the sign bit, not `< 0`, mirrors the rule (B3).
+//! the plane's triangles), and the sign bit, not `< 0`, mirrors the rule (docs/validation.md, B3).
 //!
 //! The closest hit so far is kept across leaves (a triangle straddling octants may be hit
 //! beyond the current one); a popped node starting beyond it is skipped, and the walk ends at
@@ -21,10 +21,11 @@ use crate::node::STACK;
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::{Ray, TriHit, Vec3};
 
-/// Mailbox slots (a power of two), as the grid's: 32 ids, 128 bytes per ray, not tuned.
+/// Mailbox slots (a power of two), as the grid's: 32 ids, 128 bytes per query, not tuned.
 const MAILBOX: usize = 32;
 
-type Mailbox = raybench_accel::Mailbox<MAILBOX>;
+/// The per-query record of tested triangles, for rays and closest points alike.
+pub(crate) type Mailbox = raybench_accel::Mailbox<MAILBOX>;
 
 impl Octree {
     pub(crate) fn trace<const ANY_HIT: bool, C: CounterSink>(
@@ -126,11 +127,6 @@ impl Octree {
                 }
             }
         }
-        best.map(|(prim, h)| Hit {
-            t: h.t,
-            prim,
-            u: h.u,
-            v: h.v,
-        })
+        best.map(|(prim, h)| Hit::from_tri_hit(prim, h))
     }
 }

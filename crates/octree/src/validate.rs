@@ -197,9 +197,7 @@ mod tests {
     use std::sync::Arc;
 
     fn built() -> (Octree, Arc<raybench_geom::TriangleMesh>) {
-        let mesh = raybench_testkit::scenes::generate("soup:triangles=500", 3)
-            .unwrap()
-            .mesh;
+        let mesh = raybench_testkit::generated("soup:triangles=500", 3);
         (
             Octree::build(mesh.clone(), &OctreeParams::default()).unwrap(),
             mesh,

@@ -2,19 +2,17 @@
 //! aimed at the octree's own geometry: axis-parallel, starting inside, exactly along split
 //! planes, octant edges and corners.
 
-use raybench_accel::{Accel, BuildError, Counters};
-use raybench_geom::{Ray, Vec3};
+use raybench_accel::{Accel, Counters};
+use raybench_geom::Vec3;
 use raybench_octree::{Octree, OctreeParams};
 use raybench_testkit::points::{point_conformance, point_conformance_on_shared_scenes};
-use raybench_testkit::{Case, check_case, conformance, lattice_rays, lattice_scene};
+use raybench_testkit::{
+    check_conformance, check_lattice, expect_too_large, generated, lattice_rays, lattice_scene,
+    refused_rays,
+};
 
 fn check(params: OctreeParams) {
-    let counts = conformance::<Octree>(&params, &|t, mesh| t.validate(mesh));
-    assert_eq!(counts.mismatch, 0);
-    assert!(
-        counts.exact > 10_000,
-        "the suite must exercise hits: {counts:?}"
-    );
+    check_conformance::<Octree>(&params, &|t, mesh| t.validate(mesh));
 }
 
 #[test]
@@ -54,22 +52,14 @@ fn default_conforms_on_the_shared_scenes() {
 
 #[test]
 fn too_large_is_an_error_not_an_abort() {
-    let mesh = raybench_testkit::scenes::generate("soup:triangles=2000", 1)
-        .unwrap()
-        .mesh;
+    let mesh = generated("soup:triangles=2000", 1);
     for limit in [1024, 2000 * 72 + 4096] {
         let params = OctreeParams {
             memory_limit_bytes: limit,
             max_obj: 1,
             ..OctreeParams::default()
         };
-        match Octree::build(mesh.clone(), &params) {
-            Err(BuildError::TooLarge {
-                needed_bytes,
-                limit_bytes,
-            }) => assert!(needed_bytes > limit_bytes),
-            other => panic!("limit {limit}: expected TooLarge, got {other:?}"),
-        }
+        expect_too_large::<Octree>(&mesh, &params);
     }
 }
 
@@ -84,7 +74,7 @@ fn degenerate_inputs_stop_early() {
         ("one-centroid:triangles=1000", 1.0),
         ("fan:triangles=5000", 1000.0),
     ] {
-        let mesh = raybench_testkit::scenes::generate(spec, 1).unwrap().mesh;
+        let mesh = generated(spec, 1);
         let tree = Octree::build(mesh.clone(), &OctreeParams::default()).unwrap();
         tree.validate(&mesh).unwrap();
         let s = tree.build_stats();
@@ -113,16 +103,7 @@ fn rays_along_split_planes_edges_and_corners() {
             "{:?}",
             tree.build_stats()
         );
-        let case = Case {
-            name: "split-planes".into(),
-            seed: 0x5eed_6002,
-            mesh: mesh.clone(),
-            rays: lattice_rays(),
-        };
-        let counts = check_case::<Octree>(&case, &params, &|t, m| t.validate(m))
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(counts.mismatch, 0);
-        assert!(counts.exact > 300, "{counts:?}");
+        check_lattice::<Octree>("split-planes", &params, &|t, m| t.validate(m));
     }
 }
 
@@ -136,12 +117,7 @@ fn walks_are_bounded_and_counted() {
     }
     assert!(total.mailbox_skips > 0, "{total:?}");
     assert!(total.leaves > 0 && total.nodes > 0, "{total:?}");
-    for r in [
-        Ray::infinite(Vec3::new(f32::NAN, 1.0, 1.0), Vec3::X),
-        Ray::infinite(Vec3::splat(1.0), Vec3::new(f32::NAN, 1.0, 0.0)),
-        Ray::infinite(Vec3::splat(1.0), Vec3::ZERO),
-        Ray::new(Vec3::splat(1.0), Vec3::X, f32::NAN, f32::NAN),
-    ] {
+    for r in refused_rays() {
         let mut c = Counters::default();
         let _ = tree.intersect_counted(&r, &mut c);
         assert!(c.nodes + c.leaves <= 64, "{r:?}: {c:?}");

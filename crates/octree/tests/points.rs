@@ -5,24 +5,17 @@
 use raybench_accel::{Accel, Counters};
 use raybench_geom::{TriangleMesh, Vec3};
 use raybench_octree::{Octree, OctreeParams};
-use raybench_testkit::lattice_scene;
-use raybench_testkit::points::{check_points, points_in_box, points_near_surface};
+use raybench_testkit::points::{
+    check_points, check_points_at_radii, counted_work as work, points_in_box, points_near_surface,
+    points_on_planes,
+};
+use raybench_testkit::{generated, lattice_scene};
 use std::sync::Arc;
 
 const SEED: u64 = 0x5eed_7801;
 
 fn soup() -> Arc<TriangleMesh> {
-    raybench_testkit::scenes::generate("soup:triangles=3000", SEED)
-        .unwrap()
-        .mesh
-}
-
-fn work(tree: &Octree, points: &[Vec3], radius: f32) -> Counters {
-    let mut c = Counters::default();
-    for &p in points {
-        tree.closest_point_counted(p, radius, &mut c);
-    }
-    c
+    generated("soup:triangles=3000", SEED)
 }
 
 /// The lattice scene's root is the cube [0, 4]³, so octant planes are dyadic: points on every
@@ -42,30 +35,8 @@ fn points_on_octant_planes_edges_and_corners() {
             (tree.root_box().min, tree.root_box().max),
             (Vec3::ZERO, Vec3::splat(4.0))
         );
-        let plane = |i: u32| -0.25 + 0.25 * i as f32;
-        let mut points = Vec::new();
-        for z in (0..19).step_by(3) {
-            for y in 0..19 {
-                for x in 0..19 {
-                    points.push(Vec3::new(plane(x), plane(y), plane(z)));
-                }
-            }
-        }
-        let random = points_in_box(&mesh.bounds().enlarged(0.5), 1000, SEED);
-        for (i, mut p) in random.into_iter().enumerate() {
-            p[i % 3] = plane((i % 19) as u32);
-            if i % 2 == 0 {
-                p[(i + 1) % 3] = plane((i / 3 % 19) as u32);
-            }
-            points.push(p);
-        }
-        for radius in [f32::INFINITY, 0.25, 0.0] {
-            let counts =
-                check_points(&tree, &mesh, &points, radius).unwrap_or_else(|e| panic!("{e}"));
-            if radius == f32::INFINITY {
-                assert_eq!(counts.answered(), points.len() as u64, "{counts:?}");
-            }
-        }
+        let points = points_on_planes(-0.25, 0.25, 19, 3, &mesh.bounds(), SEED);
+        check_points_at_radii(&tree, &mesh, &points);
     }
 }
 

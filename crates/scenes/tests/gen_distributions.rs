@@ -2,7 +2,7 @@
 //! shape, the distribution property each one exists for, and views that see the geometry.
 
 mod common;
-use common::{error_of, mesh_hash, scene};
+use common::{assert_rejected, mesh_hash, scene};
 use raybench_geom::{Aabb, Ray, Triangle, Vec3};
 use raybench_scenes::{Scene, primary_rays};
 use std::collections::HashMap;
@@ -454,15 +454,5 @@ fn bad_parameters_are_clear_errors() {
         ),
         ("city:max_height=100", "must be between 0.25 and 64"),
     ];
-    for (spec, expected) in cases {
-        let msg = error_of(spec);
-        assert!(
-            msg.starts_with(&format!("generator spec `{spec}`")),
-            "{msg}"
-        );
-        assert!(
-            msg.contains(expected),
-            "`{spec}`: expected `{expected}` in: {msg}"
-        );
-    }
+    assert_rejected(&cases);
 }

@@ -2,12 +2,13 @@
 //! the teapot, and what their views see (traced by brute force).
 
 mod common;
-use common::{mesh_hash, scene, within_5_percent};
+use common::{assert_rejected, mesh_hash, scene, within_5_percent};
 use raybench_geom::{Aabb, MollerTriangle, Ray};
-use raybench_scenes::{Material, Scene, Vec3, View, generate, primary_rays};
+use raybench_scenes::{Material, Scene, Vec3, View, primary_rays};
 use std::collections::HashMap;
 
-/// Columns per patch for a target (see teapot.rs, `Tessellation`): `round(sqrt(target / 64))`.
+/// Columns per patch for a target (see generate/teapot/mod.rs, `Tessellation`): `round(sqrt(target
+/// / 64))`.
 fn teapot_columns(target: f64) -> usize {
     ((target / 64.0).sqrt().round() as usize).max(1)
 }
@@ -351,18 +352,5 @@ fn bad_parameters_are_clear_errors() {
             "unknown view `aerial` (known: closeup, stadium)",
         ),
     ];
-    for (spec, expected) in cases {
-        let msg = match generate(spec, 1) {
-            Ok(s) => panic!("`{spec}` was accepted ({} triangles)", s.mesh.len()),
-            Err(e) => e.to_string(),
-        };
-        assert!(
-            msg.starts_with(&format!("generator spec `{spec}`")),
-            "{msg}"
-        );
-        assert!(
-            msg.contains(expected),
-            "`{spec}`: expected `{expected}` in: {msg}"
-        );
-    }
+    assert_rejected(&cases);
 }

@@ -1,5 +1,5 @@
 mod common;
-use common::error_of;
+use common::assert_rejected;
 use raybench_scenes::{SceneSource, generate, generators, primary_rays};
 use std::collections::HashMap;
 
@@ -31,17 +31,7 @@ fn bad_parameters_are_clear_errors() {
             "`triangles` is given twice",
         ),
     ];
-    for (spec, expected) in cases {
-        let msg = error_of(spec);
-        assert!(
-            msg.starts_with(&format!("generator spec `{spec}`")),
-            "{msg}"
-        );
-        assert!(
-            msg.contains(expected),
-            "`{spec}`: expected `{expected}` in: {msg}"
-        );
-    }
+    assert_rejected(&cases);
 }
 
 #[test]

@@ -9,25 +9,29 @@
 //! }
 //! ```
 //!
-//! Every check compares the structure with [`BruteForce`] on named, seeded scenes and ray sets,
-//! classifying each ray with `raybench_accel::classify` and requiring zero mismatches; the
-//! structure's own `validate()` runs after every build; the counted walk must give the same
-//! answers as the timed walk; any-hit must agree with closest-hit. On failure the message names
-//! the case, the seed and the exact ray bits.
+//! Every check holds the structure against [`raybench_accel::BruteForce`] on named, seeded scenes
+//! and ray sets, classifying each ray with `raybench_accel::classify` and requiring zero
+//! mismatches; the structure's own `validate()` runs after every build; the counted walk must give
+//! the same answers as the timed walk; any-hit must agree with closest-hit. On failure the message
+//! names the case, the seed and the exact ray bits.
 #![forbid(unsafe_code)]
 
 mod cases;
+mod check;
+mod lattice;
 pub mod points;
 mod rays;
 
-pub use cases::{Case, edge_cases, lattice_scene, seeded_cases};
+pub use cases::{Case, edge_cases, seeded_cases};
+pub use check::{check_case, expect_too_large, valid_rays};
+pub use lattice::{check_lattice, lattice_rays, lattice_scene};
 /// The scene generators, for structure crates' tests (which depend on testkit, not on scenes).
 pub use raybench_scenes as scenes;
-pub use rays::{centroid_rays, lattice_rays, random_rays_in, seeded_rng};
+pub use rays::{centroid_rays, random_rays_in, refused_rays, seeded_rng};
 
-use raybench_accel::classify::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
-use raybench_accel::{Accel, BruteForce, Counters};
-use raybench_geom::{Ray, TriangleMesh};
+use raybench_accel::Accel;
+use raybench_accel::classify::VerdictCounts;
+use raybench_geom::TriangleMesh;
 use std::sync::Arc;
 
 /// A structure-specific invariant check (`validate()`), run after every build.
@@ -50,169 +54,19 @@ pub fn conformance<A: Accel>(params: &A::Params, validate: Validator<'_, A>) -> 
     total
 }
 
-/// Checks one case; `Err` describes the first problem.
-pub fn check_case<A: Accel>(
-    case: &Case,
+/// [`conformance`], then the suite must have exercised hits: more than 10,000 rays with an
+/// exact answer.
+pub fn check_conformance<A: Accel>(
     params: &A::Params,
     validate: Validator<'_, A>,
-) -> Result<VerdictCounts, String> {
-    let mesh = case.mesh.clone();
-    let accel =
-        A::build(mesh.clone(), params).map_err(|e| format!("{}: build failed: {e}", case.name))?;
-    validate(&accel, &mesh).map_err(|e| format!("{}: validate() after build: {e}", case.name))?;
-    let oracle =
-        BruteForce::build(mesh.clone(), &Default::default()).expect("brute force always builds");
-    let tol = Tolerance::default();
-    let mut counts = VerdictCounts::default();
-    for (i, ray) in case.rays.iter().enumerate() {
-        let fail = |what: &str| {
-            format!(
-                "{} (seed {:#x}) ray {i} {:08x?}: {what}",
-                case.name,
-                case.seed,
-                ray.to_bits()
-            )
-        };
-        let ours = accel.intersect(ray);
-        let expected = oracle.intersect(ray);
-        let verdict = classify(&mesh, ray, ours, expected, &tol);
-        counts.add(verdict);
-        if verdict == Verdict::Mismatch {
-            return Err(fail(&format!(
-                "closest hit {ours:?}, brute force {expected:?}"
-            )));
-        }
-        let mut c = Counters::default();
-        if accel.intersect_counted(ray, &mut c) != ours {
-            return Err(fail("intersect_counted differs from intersect"));
-        }
-        let occluded = accel.occluded(ray);
-        if accel.occluded_counted(ray, &mut Counters::default()) != occluded {
-            return Err(fail("occluded_counted differs from occluded"));
-        }
-        if occluded != ours.is_some() {
-            return Err(fail(&format!(
-                "occluded() = {occluded} but intersect() = {ours:?}"
-            )));
-        }
-        let any = classify_occlusion(
-            &mesh,
-            ray,
-            occluded,
-            oracle.occluded(ray),
-            || (ours, expected),
-            &tol,
-        );
-        if any == Verdict::Mismatch {
-            return Err(fail("occluded() disagrees with brute force"));
-        }
-    }
-    check_batch_path(&accel, case)?;
-    Ok(counts)
-}
-
-/// The prepared batch path (what the harness times) must answer exactly as the single-ray path;
-/// prepared as coherent (which a structure may trace in packets), it must agree with brute force
-/// wherever it answers differently.
-fn check_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), String> {
-    check_plain_batch_path(accel, case)?;
-    check_coherent_batch_path(accel, case)
-}
-
-/// A batch prepared as coherent, traced whole and in chunks (the harness's rayon chunks start
-/// at multiples of 256; odd starts and lengths are checked too). Where it answers differently
-/// from the single-ray path, the answer must still agree with brute force, as the single-ray
-/// path's must: a packet kernel may decide a ray along an edge differently (Embree's do). The
-/// wide BVH's packet walk is held to more, bit-identical answers but for ties, in the bvh
-/// crate's tests.
-fn check_coherent_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), String> {
-    let rays = valid_rays(case);
-    let prepared = accel
-        .prepare_coherent_rays(&rays)
-        .map_err(|e| format!("{}: prepare_coherent_rays: {e}", case.name))?;
-    let oracle = BruteForce::build(case.mesh.clone(), &Default::default())
-        .expect("brute force always builds");
-    let tol = Tolerance::default();
-    let n = rays.len();
-    let splits = [
-        (0, n),
-        (0, n / 2),
-        (16.min(n), n),
-        (32.min(n), n.min(37)),
-        (5.min(n), n),
-    ];
-    for (first, end) in splits {
-        let mut hits = vec![None; end.saturating_sub(first)];
-        accel.intersect_prepared(&rays, &prepared, first, &mut hits);
-        let mut occ = vec![false; hits.len()];
-        accel.occluded_prepared(&rays, &prepared, first, &mut occ);
-        for (k, r) in rays[first..end].iter().enumerate() {
-            let fail = |what: String| {
-                format!(
-                    "{}: coherent batch [{first}..{end}) on ray {:08x?}: {what}",
-                    case.name,
-                    r.to_bits()
-                )
-            };
-            if hits[k] != accel.intersect(r) {
-                let expected = oracle.intersect(r);
-                if classify(&case.mesh, r, hits[k], expected, &tol) == Verdict::Mismatch {
-                    return Err(fail(format!(
-                        "closest hit {:?}, brute force {expected:?}",
-                        hits[k]
-                    )));
-                }
-            }
-            if occ[k] != accel.occluded(r) {
-                let any = classify_occlusion(
-                    &case.mesh,
-                    r,
-                    occ[k],
-                    oracle.occluded(r),
-                    || (hits[k], oracle.intersect(r)),
-                    &tol,
-                );
-                if any == Verdict::Mismatch {
-                    return Err(fail(format!(
-                        "occluded {} disagrees with brute force",
-                        occ[k]
-                    )));
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The case's rays that pass `Ray::check` (the batch paths take only checked rays, as the
-/// harness gives them).
-pub fn valid_rays(case: &Case) -> Vec<Ray> {
-    case.rays
-        .iter()
-        .copied()
-        .filter(|r| r.check().is_ok())
-        .collect()
-}
-
-fn check_plain_batch_path<A: Accel>(accel: &A, case: &Case) -> Result<(), String> {
-    let rays = valid_rays(case);
-    let prepared = accel
-        .prepare_rays(&rays)
-        .map_err(|e| format!("{}: prepare_rays: {e}", case.name))?;
-    let mut hits = vec![None; rays.len()];
-    accel.intersect_prepared(&rays, &prepared, 0, &mut hits);
-    let mut occ = vec![false; rays.len()];
-    accel.occluded_prepared(&rays, &prepared, 0, &mut occ);
-    for (i, r) in rays.iter().enumerate() {
-        if hits[i] != accel.intersect(r) || occ[i] != accel.occluded(r) {
-            return Err(format!(
-                "{}: batch path differs from single-ray path on ray {:08x?}",
-                case.name,
-                r.to_bits()
-            ));
-        }
-    }
-    Ok(())
+) -> VerdictCounts {
+    let counts = conformance::<A>(params, validate);
+    assert_eq!(counts.mismatch, 0);
+    assert!(
+        counts.exact > 10_000,
+        "the suite must exercise hits: {counts:?}"
+    );
+    counts
 }
 
 /// Builds a mesh from positions and indices for a case, panicking on meshes tests should never
@@ -223,6 +77,13 @@ pub fn mesh(positions: Vec<raybench_geom::Vec3>, indices: Vec<[u32; 3]>) -> Arc<
             .expect("test mesh fits 32-bit indices")
             .0,
     )
+}
+
+/// The mesh of a generated scene (`spec` as `raybench scene` takes it), panicking on a bad spec.
+pub fn generated(spec: &str, seed: u64) -> Arc<TriangleMesh> {
+    raybench_scenes::generate(spec, seed)
+        .unwrap_or_else(|e| panic!("generating {spec}: {e}"))
+        .mesh
 }
 
 /// The real scenes of `../shared/scenes` (relative to the repository), when the folder exists.

@@ -27,65 +27,12 @@ use crate::KdParams;
 use crate::clip::{halves, straddler_bounds};
 use raybench_geom::Aabb;
 use rayon::prelude::*;
+mod events;
 
-/// An event packed into one `u64` so sorting and merging compare integers: the position's
-/// order-preserving bits (32), the kind (2), the triangle id (30). Sorting the keys sorts by
-/// position, then kind (`END < PLANAR < START`), then triangle, which makes the build
-/// deterministic.
-type Event = u64;
-
-const END: u64 = 0;
-const PLANAR: u64 = 1;
-const START: u64 = 2;
-const TRI_MASK: u64 = (1 << 30) - 1;
-
-/// `f32` to `u32` preserving order (negative values flipped); `-0` is first made `+0` so the
-/// two zeros are one position, as they compare equal.
-#[inline(always)]
-fn ord(x: f32) -> u32 {
-    let b = (x + 0.0).to_bits();
-    if b >> 31 == 1 { !b } else { b | 0x8000_0000 }
-}
-
-#[inline(always)]
-fn unord(u: u32) -> f32 {
-    f32::from_bits(if u >> 31 == 1 { u & 0x7fff_ffff } else { !u })
-}
-
-#[inline(always)]
-fn event(pos: f32, kind: u64, tri: u32) -> Event {
-    ((ord(pos) as u64) << 32) | (kind << 30) | tri as u64
-}
-
-#[inline(always)]
-fn pos_of(e: Event) -> u32 {
-    (e >> 32) as u32
-}
-
-#[inline(always)]
-fn kind_of(e: Event) -> u64 {
-    (e >> 30) & 3
-}
-
-#[inline(always)]
-fn tri_of(e: Event) -> u32 {
-    (e & TRI_MASK) as u32
-}
-
-type Events = [Vec<Event>; 3];
-
-/// The events of one triangle whose bounds in the current cell are `b`.
-fn push_events(ev: &mut Events, b: &Aabb, tri: u32) {
-    for (a, list) in ev.iter_mut().enumerate() {
-        let (lo, hi) = (b.min[a], b.max[a]);
-        if lo == hi {
-            list.push(event(lo, PLANAR, tri));
-        } else {
-            list.push(event(lo, START, tri));
-            list.push(event(hi, END, tri));
-        }
-    }
-}
+use events::{
+    END, Events, PLANAR, START, kind_of, merge_into, ord, pos_of, push_events, radix_sort, tri_of,
+    unord,
+};
 
 pub(crate) fn build(ctx: &Ctx, ids: &[u32], root: &Aabb, out: &mut Out) {
     let mut ev: Events = Default::default();
@@ -102,7 +49,7 @@ pub(crate) fn build(ctx: &Ctx, ids: &[u32], root: &Aabb, out: &mut Out) {
 
 /// Per-task working memory, reused by every node the task builds: the side table indexed by
 /// triangle id, and the straddlers' new events before they are merged (no allocation per node
-/// for either; callgrind on the bunny put allocation at 17 % of the build before).
+/// for either; measured: see docs/experiments.md, k-d tree, per-task scratch).
 pub(crate) struct Scratch {
     side: Vec<u8>,
     straddlers: Vec<u32>,
@@ -336,56 +283,9 @@ fn split_events(
     (below, only_below + k, above, only_above + k)
 }
 
-/// Sorts events pushed in increasing triangle order: a stable LSD radix sort on the 34 bits of
-/// position and kind (three passes of 12, 11 and 11 bits), which leaves events with the same
-/// position and kind in triangle order, i.e. sorts the whole `u64` keys. The one O(N log N)
-/// sort of the build (callgrind on the bunny: 1/10 of the instructions of `sort_unstable`).
-fn radix_sort(keys: &mut Vec<Event>) {
-    let mut tmp = vec![0u64; keys.len()];
-    for (shift, bits) in [(30u32, 12u32), (42, 11), (53, 11)] {
-        let mask = (1u64 << bits) - 1;
-        let mut offsets = vec![0usize; 1 << bits];
-        for &k in keys.iter() {
-            offsets[((k >> shift) & mask) as usize] += 1;
-        }
-        let mut sum = 0;
-        for o in offsets.iter_mut() {
-            let c = *o;
-            *o = sum;
-            sum += c;
-        }
-        for &k in keys.iter() {
-            let d = ((k >> shift) & mask) as usize;
-            tmp[offsets[d]] = k;
-            offsets[d] += 1;
-        }
-        std::mem::swap(keys, &mut tmp);
-    }
-}
-
-/// Merges the sorted `b` into the sorted `a`, in place from the back (no second buffer: `a`
-/// usually has the room reserved already).
-fn merge_into(a: &mut Vec<Event>, b: &[Event]) {
-    if b.is_empty() {
-        return;
-    }
-    let (mut i, mut j) = (a.len(), b.len());
-    a.resize(i + j, 0);
-    let mut w = a.len();
-    while j > 0 {
-        w -= 1;
-        if i > 0 && a[i - 1] > b[j - 1] {
-            a[w] = a[i - 1];
-            i -= 1;
-        } else {
-            a[w] = b[j - 1];
-            j -= 1;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::events::{Event, event};
     use super::*;
     use crate::clip::{Side, clipped_bounds, side};
     use raybench_geom::{Triangle, Vec3};

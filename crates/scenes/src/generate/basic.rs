@@ -188,8 +188,15 @@ fn plane(quads: u64, tilt_deg: f32) -> Mesh {
             positions.push(Vec3::new(coord(col), z * sin_t, z * cos_t));
         }
     }
+    (positions, quad_grid_indices(n), plane_view())
+}
+
+/// The triangles of an `n × n` grid of quads over `(n + 1)²` vertices stored row by row: two
+/// per quad, `[a, c, d]` and `[a, d, b]` with `a`, `b` the quad's corners on its first row and
+/// `c`, `d` those on the next.
+pub(super) fn quad_grid_indices(n: u32) -> Vec<[u32; 3]> {
     let at = |row: u32, col: u32| row * (n + 1) + col;
-    let mut indices = Vec::with_capacity(2 * (n * n) as usize);
+    let mut indices = Vec::with_capacity(2 * (n as usize) * (n as usize));
     for row in 0..n {
         for col in 0..n {
             let (a, b) = (at(row, col), at(row, col + 1));
@@ -198,7 +205,7 @@ fn plane(quads: u64, tilt_deg: f32) -> Mesh {
             indices.push([a, d, b]);
         }
     }
-    (positions, indices, plane_view())
+    indices
 }
 
 /// From above and in front of the plane, which spans about ±1 around the origin.

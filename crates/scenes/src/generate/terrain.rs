@@ -245,18 +245,7 @@ impl HeightGrid {
 
     /// Indices into [`HeightGrid::positions`].
     pub(super) fn indices(&self) -> Vec<[u32; 3]> {
-        let n = self.quads;
-        let at = |row: u32, col: u32| row * (n + 1) + col;
-        let mut indices = Vec::with_capacity(Self::triangle_count(n) as usize);
-        for row in 0..n {
-            for col in 0..n {
-                let (a, b) = (at(row, col), at(row, col + 1));
-                let (c, d) = (at(row + 1, col), at(row + 1, col + 1));
-                indices.push([a, c, d]);
-                indices.push([a, d, b]);
-            }
-        }
-        indices
+        super::basic::quad_grid_indices(self.quads)
     }
 
     /// The height of the triangulated surface (not of the noise) at `(x, z)`, clamped to the

@@ -21,7 +21,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 /// Beyond this magnitude the f32 spacing is ≥ 1 (from 2^23 ≈ 8.4e6 up): "far from the origin"
-/// precision, worth a note (reliability.md §4.2).
+/// precision, worth a note (docs/validation.md, Loader).
 const FAR_COORDINATE: f32 = 1e7;
 
 /// Loads an OBJ file as a scene named after the file stem, with a default view from its bounds.

@@ -1,4 +1,5 @@
-//! Fixture files written to a fresh temporary directory per test and removed afterwards.
+//! What the scenes tests share: fixture files written to a fresh temporary directory per test
+//! and removed afterwards, generated scenes, rejected specs and mesh hashes.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
@@ -49,6 +50,22 @@ pub fn error_of(spec: &str) -> String {
     match raybench_scenes::generate(spec, 1) {
         Ok(s) => panic!("`{spec}` was accepted ({} triangles)", s.mesh.len()),
         Err(e) => e.to_string(),
+    }
+}
+
+/// Every spec of `cases` is rejected with a message that names the spec first and contains
+/// the expected text.
+pub fn assert_rejected(cases: &[(&str, &str)]) {
+    for &(spec, expected) in cases {
+        let msg = error_of(spec);
+        assert!(
+            msg.starts_with(&format!("generator spec `{spec}`")),
+            "{msg}"
+        );
+        assert!(
+            msg.contains(expected),
+            "`{spec}`: expected `{expected}` in: {msg}"
+        );
     }
 }
 
