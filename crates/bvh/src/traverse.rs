@@ -122,12 +122,7 @@ impl Bvh {
                 break;
             }
         }
-        best.map(|(i, h)| Hit {
-            t: h.t,
-            prim: self.prim_ids[i],
-            u: h.u,
-            v: h.v,
-        })
+        best.map(|(i, h)| Hit::from_tri_hit(self.prim_ids[i], h))
     }
 }
 

@@ -126,9 +126,7 @@ mod tests {
     use std::sync::Arc;
 
     fn built() -> (Bvh, Arc<raybench_geom::TriangleMesh>) {
-        let mesh = raybench_testkit::scenes::generate("soup:triangles=500", 3)
-            .unwrap()
-            .mesh;
+        let mesh = raybench_testkit::generated("soup:triangles=500", 3);
         (
             Bvh::build(mesh.clone(), &BvhParams::binned()).unwrap(),
             mesh,

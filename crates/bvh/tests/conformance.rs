@@ -91,9 +91,7 @@ fn four_wide_conforms() {
 #[test]
 fn a_width_other_than_the_trees_is_refused() {
     use raybench_accel::{Accel, BuildError};
-    let mesh = raybench_testkit::scenes::generate("soup:triangles=100", 1)
-        .expect("generates")
-        .mesh;
+    let mesh = raybench_testkit::generated("soup:triangles=100", 1);
     for r in [
         Bvh4::build(mesh.clone(), &WideParams::for_width(8)).map(|_| ()),
         Bvh8::build(mesh.clone(), &WideParams::for_width(4)).map(|_| ()),
@@ -111,9 +109,7 @@ fn a_width_other_than_the_trees_is_refused() {
 #[test]
 fn both_widths_share_the_leaves_and_differ_in_depth() {
     use raybench_accel::Accel;
-    let mesh = raybench_testkit::scenes::generate("teapot:triangles=20000", 1)
-        .expect("generates")
-        .mesh;
+    let mesh = raybench_testkit::generated("teapot:triangles=20000", 1);
     let unfilled = |width| WideParams {
         fill_slots: false,
         ..WideParams::for_width(width)
@@ -145,9 +141,7 @@ fn both_widths_share_the_leaves_and_differ_in_depth() {
 fn filling_slots_splits_leaves_and_lowers_the_sah() {
     fn check<const W: usize>(spec: &str) {
         use raybench_accel::Accel;
-        let mesh = raybench_testkit::scenes::generate(spec, 1)
-            .expect("generates")
-            .mesh;
+        let mesh = raybench_testkit::generated(spec, 1);
         let with = |fill_slots| {
             let p = WideParams {
                 fill_slots,
@@ -200,9 +194,7 @@ fn wide_trees_are_the_same_with_one_and_two_threads() {
         assert!(one.nodes() == two.nodes(), "{W} wide: nodes differ");
         assert!(one.tri4s() == two.tri4s(), "{W} wide: Tri4s differ");
     }
-    let mesh = raybench_testkit::scenes::generate("teapot:triangles=20000", 1)
-        .expect("generates")
-        .mesh;
+    let mesh = raybench_testkit::generated("teapot:triangles=20000", 1);
     check::<8>(&mesh);
     check::<4>(&mesh);
 }
@@ -219,9 +211,7 @@ fn sse_matches_avx2_at<const W: usize>() {
     };
     let counts = conformance::<BvhWide<W>>(&sse, &|b, mesh| b.validate(mesh));
     assert_eq!(counts.mismatch, 0);
-    let mesh = raybench_testkit::scenes::generate("teapot:triangles=5000", 1)
-        .expect("generates")
-        .mesh;
+    let mesh = raybench_testkit::generated("teapot:triangles=5000", 1);
     for max_leaf_size in [4, 16] {
         let with = |p: &WideParams| {
             let mut p = p.clone();
@@ -249,9 +239,7 @@ fn sse_matches_avx2_at<const W: usize>() {
 fn avx2_only_conforms_at<const W: usize>() {
     use raybench_accel::Accel;
     let auto = BvhWide::<W>::build(
-        raybench_testkit::scenes::generate("sphere:triangles=200", 1)
-            .expect("generates")
-            .mesh,
+        raybench_testkit::generated("sphere:triangles=200", 1),
         &WideParams::for_width(W as u32),
     )
     .expect("builds");
@@ -369,9 +357,7 @@ fn point_queries_conform_on_the_shared_scenes() {
 #[test]
 fn too_large_is_an_error_not_an_abort() {
     use raybench_accel::{Accel, BuildError};
-    let mesh = raybench_testkit::scenes::generate("soup:triangles=2000", 1)
-        .expect("generates")
-        .mesh;
+    let mesh = raybench_testkit::generated("soup:triangles=2000", 1);
     let small = BvhParams {
         memory_limit_bytes: 64 * 1024,
         ..BvhParams::binned()

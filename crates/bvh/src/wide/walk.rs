@@ -153,12 +153,7 @@ impl<const W: usize> BvhWide<W> {
                 }
             }
         }
-        best.map(|(lane, h)| Hit {
-            t: h.t,
-            prim: self.tri4s[lane / 4].ids[lane % 4],
-            u: h.u,
-            v: h.v,
-        })
+        best.map(|(lane, h)| Hit::from_tri_hit(self.tri4s[lane / 4].ids[lane % 4], h))
     }
 
     /// Starts fetching every child in `mask`: a node's four (8 wide) or two (4 wide) lines, or
