@@ -4,8 +4,9 @@
 
 mod common;
 
-use raybench_harness::report::Report;
-use raybench_harness::run::{RunOptions, SceneRequest, run};
+use raybench_harness::pipeline::run::{RunOptions, run};
+use raybench_harness::report::run::Report;
+use raybench_scenes::SceneRequest;
 use raybench_scenes::generators;
 
 const STRUCTURES: [&str; 6] = [

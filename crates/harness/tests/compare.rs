@@ -3,9 +3,10 @@
 
 mod common;
 
-use raybench_harness::compare::{CompareOptions, Severity, compare};
-use raybench_harness::report::Report;
-use raybench_harness::run::{SceneRequest, run};
+use raybench_harness::pipeline::run::run;
+use raybench_harness::report::compare::{CompareOptions, Severity, compare};
+use raybench_harness::report::run::Report;
+use raybench_scenes::SceneRequest;
 use std::process::Command;
 use std::sync::OnceLock;
 
@@ -14,7 +15,7 @@ fn base() -> &'static Report {
     static REPORT: OnceLock<Report> = OnceLock::new();
     REPORT.get_or_init(|| {
         let opts = raybench_scenes::Workload::ALL[..2].to_vec();
-        let options = raybench_harness::run::RunOptions {
+        let options = raybench_harness::pipeline::run::RunOptions {
             workloads: opts,
             rays: 1000,
             ..common::options(&["bruteforce", "bvh-binned", "embree-medium"])
@@ -32,7 +33,7 @@ fn regressions(new: &Report, opts: &CompareOptions) -> Vec<String> {
         .collect()
 }
 
-fn bvh(report: &mut Report) -> &mut raybench_harness::report::ResultEntry {
+fn bvh(report: &mut Report) -> &mut raybench_harness::report::run::ResultEntry {
     report
         .results
         .iter_mut()

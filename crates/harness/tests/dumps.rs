@@ -4,10 +4,11 @@
 
 mod common;
 
-use raybench_harness::dump::{read_dump, read_index};
+use raybench_harness::pipeline::dump::{read_dump, read_index};
+use raybench_harness::pipeline::run::{RunOptions, run};
 use raybench_harness::registry::{self, BuildContext};
-use raybench_harness::report::Report;
-use raybench_harness::run::{RunOptions, SceneRequest, run};
+use raybench_harness::report::run::Report;
+use raybench_scenes::SceneRequest;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

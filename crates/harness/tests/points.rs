@@ -2,12 +2,13 @@
 
 mod common;
 
-use raybench_harness::compare::{CompareOptions, Severity, compare};
-use raybench_harness::measure::point_pass;
+use raybench_harness::pipeline::check::validate_points;
+use raybench_harness::pipeline::measure::point_pass;
+use raybench_harness::pipeline::run::{RunOptions, run};
 use raybench_harness::registry::{self, BuildContext};
-use raybench_harness::report::{Report, WorkloadResult};
-use raybench_harness::run::{RunOptions, SceneRequest, run};
-use raybench_harness::validate::validate_points;
+use raybench_harness::report::compare::{CompareOptions, Severity, compare};
+use raybench_harness::report::run::{Report, WorkloadResult};
+use raybench_scenes::SceneRequest;
 use raybench_scenes::Workload;
 use raybench_scenes::points::PointWorkload;
 

@@ -4,13 +4,14 @@
 
 use raybench_accel::Hit;
 use raybench_geom::{Ray, Vec3};
-use raybench_harness::dump::{read_dump, read_index};
-use raybench_harness::report::DisputedRay;
-use raybench_harness::run::SceneRequest;
-use raybench_harness::verify::{
-    REFERENCES, VerifyOptions, VerifyReport, brute_force_sample, verify, verify_table,
-};
-use raybench_harness::watertight::{Case, EMBREE_POSITION, WatertightOptions, watertight};
+use raybench_harness::output::verify_table::verify_table;
+use raybench_harness::pipeline::dump::{read_dump, read_index};
+use raybench_harness::pipeline::verify::{REFERENCES, VerifyOptions, brute_force_sample, verify};
+use raybench_harness::pipeline::watertight::{EMBREE_POSITION, WatertightOptions, watertight};
+use raybench_harness::report::agreement::DisputedRay;
+use raybench_harness::report::verify::VerifyReport;
+use raybench_harness::report::watertight::Case;
+use raybench_scenes::SceneRequest;
 use raybench_scenes::Workload;
 use std::path::PathBuf;
 use std::sync::OnceLock;

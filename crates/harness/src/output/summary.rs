@@ -1,8 +1,8 @@
 //! The table printed at the end of a run: build time, throughput and agreement per scene ×
 //! structure, each with its ratio to the reference measured in the same run.
 
-use crate::agreement::{agreement_sentence_of, class_counts};
-use crate::report::{Report, is_point_workload};
+use super::agreement::{agreement_sentence_of, class_counts};
+use crate::report::run::{Report, is_point_workload};
 use raybench_accel::classify::VerdictCounts;
 use std::fmt::Write;
 
@@ -91,7 +91,7 @@ pub fn summary_table(report: &Report) -> String {
 }
 
 /// Agreement with the reference per structure (all scenes and workloads) and overall, in the
-/// words of [`crate::agreement`], with the counts of every class.
+/// words of [`super::agreement`], with the counts of every class.
 fn write_agreement(out: &mut String, report: &Report) {
     let _ = writeln!(
         out,

@@ -1,8 +1,9 @@
 //! `index.html`: one static page (no JavaScript) with the tables, charts, pictures and the
 //! environment fingerprint of a report.
 
-use super::{ChartFile, ScenePictures, scene_names, structure_names, workload_names};
-use crate::report::Report;
+use super::names::{scene_names, structure_names, workload_names};
+use super::{ChartFile, ScenePictures};
+use crate::report::run::{Report, throughput_unit};
 use std::fmt::Write as _;
 
 pub(crate) fn escape(s: &str) -> String {
@@ -81,7 +82,7 @@ fn results_table(s: &mut String, report: &Report) {
                 <th>triangles</th><th>build ms (× ref)</th><th>bytes / triangle</th><th>SAH</th>",
     );
     for w in &workloads {
-        let unit = crate::report::throughput_unit(w);
+        let unit = throughput_unit(w);
         let _ = write!(s, "<th>{} {unit} (× ref)</th>", escape(w));
     }
     s.push_str("<th>mismatches</th></tr>\n");

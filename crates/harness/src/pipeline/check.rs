@@ -1,8 +1,8 @@
 //! Checks a structure's answers against the reference's, ray by ray (or query point by query
 //! point), with the validation classes of `raybench_accel::classify` (and `classify_points`).
 
-use crate::measure::Answers;
-use crate::report::{DisputedPoint, DisputedRay, Validation};
+use super::measure::Answers;
+use crate::report::agreement::{DisputedPoint, DisputedRay, Validation};
 use raybench_accel::classify::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
 use raybench_accel::classify_points::{classify_point, point_tolerance};
 use raybench_accel::{Accel, PointHit};

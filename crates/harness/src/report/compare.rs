@@ -14,7 +14,7 @@
 //! Entries in the base that the new report lacks fail too (a structure that stopped building is
 //! not "no regression"); entries only in the new report are listed as new.
 
-use crate::report::{Report, ResultEntry, WorkloadResult, is_point_workload, throughput_unit};
+use super::run::{Report, ResultEntry, WorkloadResult, is_point_workload, throughput_unit};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 

@@ -7,7 +7,7 @@
 //! counting passes are separate, untimed, single-threaded walks.
 
 use crate::registry::{BuildContext, Built, StructureEntry};
-use crate::report::{Throughput, Timing};
+use crate::report::run::{Throughput, Timing};
 use raybench_accel::{Accel, BuildError, Counters, Hit, PointHit, PreparedRays};
 use raybench_geom::{Ray, TriangleMesh, Vec3};
 use rayon::prelude::*;

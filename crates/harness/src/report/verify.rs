@@ -1,0 +1,125 @@
+//! `verify.json`: the schema of what `raybench verify` writes, and reading it back.
+
+use super::agreement::Validation;
+use super::run::TriangleCounts;
+use super::write_json_atomic;
+use crate::env::Environment;
+use anyhow::{Context, Result, ensure};
+use raybench_accel::classify::{Tolerance, VerdictCounts};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Bumped whenever a field of `verify.json` changes meaning or disappears.
+pub const VERIFY_SCHEMA_VERSION: u32 = 1;
+
+/// `verify.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct VerifyReport {
+    pub schema_version: u32,
+    pub tool_version: String,
+    pub environment: Environment,
+    pub settings: VerifySettings,
+    pub scenes: Vec<VerifiedScene>,
+    /// One entry per scene × structure × workload, with one validation per reference.
+    pub results: Vec<VerifiedWorkload>,
+    /// Per structure × reference, summed over scenes and workloads (what the table prints).
+    pub totals: Vec<AgreementRow>,
+    pub notes: Vec<String>,
+    pub errors: Vec<String>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct VerifySettings {
+    pub suite: Option<String>,
+    pub seed: u64,
+    pub rays: usize,
+    /// Query points per closest-point workload (0 in files older than point workloads).
+    #[serde(default)]
+    pub points: usize,
+    pub threads: usize,
+    pub structures: Vec<String>,
+    pub workloads: Vec<String>,
+    pub references: Vec<String>,
+    /// Ray–triangle tests brute force may spend per scene × workload.
+    pub brute_force_budget: u64,
+    pub tolerance: Tolerance,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct VerifiedScene {
+    /// The name results use (unique within the run).
+    pub name: String,
+    /// What `raybench replay --scene` takes to rebuild it (a spec or an OBJ path).
+    pub spec: String,
+    pub triangles: TriangleCounts,
+    pub workloads: Vec<SampledWorkload>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SampledWorkload {
+    pub workload: String,
+    pub rays: usize,
+    /// Rays the `bruteforce` reference checked (evenly spaced; all when affordable).
+    pub brute_force_rays: usize,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct VerifiedWorkload {
+    pub scene: String,
+    pub structure: String,
+    pub workload: String,
+    pub any_hit: bool,
+    /// Rays this structure traced: every ray, or the brute-force subsample for brute force.
+    pub rays: usize,
+    pub subsampled: bool,
+    /// Rays where the counted path answered differently from the timed path (a bug).
+    pub counted_path_differs: u64,
+    /// One per reference, in [`REFERENCES`] order. Disputed rays carry their index in the
+    /// workload's full ray list.
+    pub validations: Vec<Validation>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct AgreementRow {
+    pub structure: String,
+    pub reference: String,
+    pub rays: u64,
+    #[serde(flatten)]
+    pub counts: VerdictCounts,
+    pub counted_path_differs: u64,
+    pub mismatch_rate_upper95: f64,
+    /// "0 mismatches in n rays (95% upper bound 3/n = …)" or "k mismatches in n rays".
+    pub agreement: String,
+}
+
+impl VerifyReport {
+    /// Mismatches against any reference plus counted-path differences: anything non-zero is a
+    /// bug somewhere (exit status 2).
+    pub fn mismatches(&self) -> u64 {
+        self.results
+            .iter()
+            .map(|r| {
+                r.counted_path_differs
+                    + r.validations.iter().map(|v| v.counts.mismatch).sum::<u64>()
+            })
+            .sum()
+    }
+
+    /// Writes `dir/verify.json` atomically.
+    pub fn write_atomic(&self, dir: &Path) -> Result<PathBuf> {
+        write_json_atomic(dir, "verify.json", self)
+    }
+
+    pub fn read(path: &Path) -> Result<VerifyReport> {
+        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+        let report: VerifyReport = serde_json::from_slice(&bytes)
+            .with_context(|| format!("parsing {}", path.display()))?;
+        ensure!(
+            report.schema_version == VERIFY_SCHEMA_VERSION,
+            "{}: schema_version {} is not the supported {VERIFY_SCHEMA_VERSION}",
+            path.display(),
+            report.schema_version
+        );
+        Ok(report)
+    }
+}
