@@ -113,7 +113,7 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
         .results
         .iter()
         .flat_map(|r| &r.workloads)
-        .filter(|w| w.workload == "points-near" && w.point_query && w.rays == 300)
+        .filter(|w| w.workload == "points-near" && w.point_query && w.queries == 300)
         .count();
     assert!(
         points_near >= 9 * 14,
@@ -325,10 +325,10 @@ fn point_workloads_run_from_the_command_line_and_unknown_ones_are_refused() {
     for r in &report.results {
         let w = &r.workloads[..];
         assert!(
-            w.len() == 1 && w[0].point_query && w[0].rays == 250,
+            w.len() == 1 && w[0].point_query && w[0].queries == 250,
             "{w:?}"
         );
-        assert_eq!(w[0].validation.counts.mismatch, 0);
+        assert_eq!(w[0].agreement.counts.mismatch, 0);
     }
     std::fs::remove_dir_all(dir).unwrap();
     for command in ["run", "verify"] {

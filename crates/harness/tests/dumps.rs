@@ -65,7 +65,7 @@ fn a_dump_matches_the_report_and_a_re_trace() {
         let dump = read_dump(&dir.join(&e.file)).unwrap();
         assert_eq!(
             (dump.records.len(), dump.any_hit),
-            (w.rays, w.any_hit),
+            (w.queries, w.any_hit),
             "{}",
             e.file
         );

@@ -16,7 +16,7 @@ pub fn replay_commands(report: &VerifyReport, n: usize) -> Vec<String> {
         let Some(scene) = report.scenes.iter().find(|s| s.name == r.scene) else {
             continue;
         };
-        for v in &r.validations {
+        for v in &r.agreements {
             for d in &v.first_point_mismatches {
                 out.push(format!(
                         "# {} / {} point {}: {} vs {}: {} (point bits {}; `raybench replay` takes rays only)",
@@ -124,7 +124,7 @@ pub fn verify_table(report: &VerifyReport) -> String {
             "{:<22} {:<14} {:>9} {:>9} {:>9} {:>10} {:>6} {:>8} {:>8} {:>8} {:>8}  {}",
             row.structure,
             row.reference,
-            row.rays,
+            row.queries,
             c.both_miss,
             c.exact,
             c.within_tolerance,
@@ -178,8 +178,8 @@ fn brute_force_coverage(report: &VerifyReport) -> String {
     let (mut checked, mut total) = (0, 0);
     let mut subsampled = Vec::new();
     for scene in &report.scenes {
-        let c: usize = scene.workloads.iter().map(|w| w.brute_force_rays).sum();
-        let t: usize = scene.workloads.iter().map(|w| w.rays).sum();
+        let c: usize = scene.workloads.iter().map(|w| w.brute_force_queries).sum();
+        let t: usize = scene.workloads.iter().map(|w| w.queries).sum();
         checked += c;
         total += t;
         if c < t {

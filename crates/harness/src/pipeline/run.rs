@@ -1,11 +1,13 @@
 //! `raybench run`: load scenes, generate one ray set (or query point set) per workload from the
-//! reference, build and time every structure, count, validate, and assemble the report.
+//! reference, build and time every structure, count, check every answer, and assemble the report.
 //!
 //! Ray workloads and closest-point workloads share the pipeline (build once, warm-up + median
 //! of timed passes, an untimed counted pass, validation against the reference) but not the code
 //! that handles rays: [`SceneRun`] keeps the two kinds in separate lists.
 
-use super::check::{Sides, count_differences, count_point_differences, validate, validate_points};
+use super::check::{
+    Sides, check_answers, check_points, counted_path_differences, counted_point_differences,
+};
 use super::dump::{DumpDir, points_not_dumped};
 use super::images::{PixelInput, PrimaryImage, shade};
 use super::measure::{
@@ -179,11 +181,11 @@ impl SceneRun<'_> {
                 reference: self.reference.as_ref(),
                 reference_name: &self.reference_name,
             };
-            let (mut validation, levels) =
-                validate(&s.mesh, &wl.rays, &answers, &wl.reference, &sides, tol);
-            let paths = count_differences(&s.mesh, &wl.rays, &answers, &counted, tol);
-            validation.counted_path_differs = paths.differs;
-            validation.counted_path_ties = paths.ties;
+            let (mut agreement, levels) =
+                check_answers(&s.mesh, &wl.rays, &answers, &wl.reference, &sides, tol);
+            let paths = counted_path_differences(&s.mesh, &wl.rays, &answers, &counted, tol);
+            agreement.counted_path_differs = paths.differs;
+            agreement.counted_path_ties = paths.ties;
             if let Some(d) = dump.as_deref_mut() {
                 d.write(
                     &s.name,
@@ -207,15 +209,15 @@ impl SceneRun<'_> {
             }
             workloads.push(WorkloadResult {
                 workload: wl.workload.name().to_string(),
-                rays: wl.rays.len(),
+                queries: wl.rays.len(),
                 any_hit,
                 point_query: false,
-                mrays_per_s: mrays,
+                mqueries_per_s: mrays,
                 speedup_vs_reference: None,
-                counters_per_ray: has_counters
-                    .then(|| CountersPerRay::from_total(&counters, wl.rays.len())),
+                counters_per_query: has_counters
+                    .then(|| CountersPerQuery::from_total(&counters, wl.rays.len())),
                 counters_total: has_counters.then_some(counters),
-                validation,
+                agreement,
             });
         }
         for pw in self.point_workloads.iter().filter(|w| !w.points.is_empty()) {
@@ -250,7 +252,7 @@ impl SceneRun<'_> {
             time_point_queries(accel, &pw.points, pw.radius, opts.threads, opts.trace_runs);
         let (counted, counters) = count_point_pass(accel, &pw.points, pw.radius);
         let mesh = &self.scene.scene.mesh;
-        let mut validation = validate_points(
+        let mut agreement = check_points(
             mesh,
             &pw.points,
             pw.radius,
@@ -258,19 +260,19 @@ impl SceneRun<'_> {
             &pw.reference,
             &self.reference_name,
         );
-        validation.counted_path_differs = count_point_differences(&answers, &counted);
+        agreement.counted_path_differs = counted_point_differences(&answers, &counted);
         let has_counters = accel.has_counters();
         WorkloadResult {
             workload: pw.workload.name().to_string(),
-            rays: pw.points.len(),
+            queries: pw.points.len(),
             any_hit: false,
             point_query: true,
-            mrays_per_s: throughput,
+            mqueries_per_s: throughput,
             speedup_vs_reference: None,
-            counters_per_ray: has_counters
-                .then(|| CountersPerRay::from_total(&counters, pw.points.len())),
+            counters_per_query: has_counters
+                .then(|| CountersPerQuery::from_total(&counters, pw.points.len())),
             counters_total: has_counters.then_some(counters),
-            validation,
+            agreement,
         }
     }
 }
@@ -293,8 +295,8 @@ fn fill_ratios(report: &mut Report) {
         for w in &mut r.workloads {
             let base_w = base.workloads.iter().find(|b| b.workload == w.workload);
             w.speedup_vs_reference = base_w
-                .filter(|b| b.mrays_per_s.median > 0.0)
-                .map(|b| w.mrays_per_s.median / b.mrays_per_s.median);
+                .filter(|b| b.mqueries_per_s.median > 0.0)
+                .map(|b| w.mqueries_per_s.median / b.mqueries_per_s.median);
         }
     }
 }

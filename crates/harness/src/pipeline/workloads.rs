@@ -100,7 +100,7 @@ impl<'a> SceneRun<'a> {
                 .iter()
                 .map(|w| WorkloadRecord {
                     workload: w.workload.name().to_string(),
-                    rays: w.rays.len(),
+                    queries: w.rays.len(),
                     any_hit: w.workload.any_hit(),
                     point_query: false,
                     width: w.size.map(|s| s.0),
@@ -108,7 +108,7 @@ impl<'a> SceneRun<'a> {
                 })
                 .chain(self.point_workloads.iter().map(|w| WorkloadRecord {
                     workload: w.workload.name().to_string(),
-                    rays: w.points.len(),
+                    queries: w.points.len(),
                     any_hit: false,
                     point_query: true,
                     width: None,
@@ -137,7 +137,7 @@ fn ray_workloads(
             bail!("{wl} is a closest-point workload, not a ray workload")
         };
         let size = (wl == Workload::Primary).then(|| recipe.image_size());
-        check_rays(wl, &rays)?;
+        ensure_traceable(wl, &rays)?;
         let reference_answers = reference_answers(reference, &rays, wl.any_hit(), threads)?;
         prepared.push(PreparedWorkload {
             workload: wl,
@@ -164,7 +164,7 @@ fn point_workload(
         .context("a ray workload among the point workloads")?;
     let points = kind.generate(&s.mesh, count, seed);
     let radius = kind.default_radius();
-    check_points(workload, &points, radius)?;
+    ensure_queryable(workload, &points, radius)?;
     let mut answers = vec![None; points.len()];
     point_pass(reference, &points, radius, threads, &mut answers);
     Ok(PreparedPoints {
@@ -176,7 +176,7 @@ fn point_workload(
 }
 
 /// Every generated query must be one Embree can take; a bad one is a generator bug, named here.
-fn check_points(wl: Workload, points: &[Vec3], radius: f32) -> Result<()> {
+fn ensure_queryable(wl: Workload, points: &[Vec3], radius: f32) -> Result<()> {
     for (i, &p) in points.iter().enumerate() {
         if raybench_geom::query_radius_squared(p, radius).is_none() {
             bail!(
@@ -208,7 +208,7 @@ pub(crate) fn triangle_counts(s: &Scene) -> TriangleCounts {
 }
 
 /// Every generated ray must be traceable by Embree; a bad one is a generator bug, named here.
-fn check_rays(wl: Workload, rays: &[Ray]) -> Result<()> {
+fn ensure_traceable(wl: Workload, rays: &[Ray]) -> Result<()> {
     for (i, r) in rays.iter().enumerate() {
         if let Err(e) = r.check() {
             bail!(

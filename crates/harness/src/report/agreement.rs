@@ -7,7 +7,7 @@ use raybench_geom::{Ray, Vec3};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Validation {
+pub struct Agreement {
     pub reference: String,
     /// Rays per class: `both_miss`, `exact`, `within_tolerance`, `tie`, `boundary`,
     /// `edge_ambiguous`, `mismatch` (written flat into this object).
@@ -29,15 +29,15 @@ pub struct Validation {
     pub first_point_mismatches: Vec<DisputedPoint>,
 }
 
-impl Validation {
-    pub fn new(reference: &str, counts: VerdictCounts) -> Validation {
+impl Agreement {
+    pub fn new(reference: &str, counts: VerdictCounts) -> Agreement {
         let n = counts.total().max(1) as f64;
         let upper95 = if counts.mismatch == 0 {
             (3.0 / n).min(1.0)
         } else {
             counts.mismatch as f64 / n
         };
-        Validation {
+        Agreement {
             reference: reference.to_string(),
             counts,
             counted_path_differs: 0,
@@ -49,7 +49,7 @@ impl Validation {
         }
     }
 
-    pub fn rays(&self) -> u64 {
+    pub fn queries(&self) -> u64 {
         self.counts.total()
     }
 }

@@ -301,7 +301,7 @@ fn compare_build_time(
 fn reference_name(e: &ResultEntry) -> String {
     e.workloads
         .first()
-        .map(|w| w.validation.reference.clone())
+        .map(|w| w.agreement.reference.clone())
         .unwrap_or_default()
 }
 
@@ -314,7 +314,7 @@ fn compare_workload(
     opts: &CompareOptions,
     findings: &mut Vec<Finding>,
 ) {
-    let bad = |w: &WorkloadResult| w.validation.counts.mismatch + w.validation.counted_path_differs;
+    let bad = |w: &WorkloadResult| w.agreement.counts.mismatch + w.agreement.counted_path_differs;
     if bad(n) > bad(b) {
         findings.push(Finding {
             severity: Severity::Regression,
@@ -347,7 +347,7 @@ fn compare_workload(
 }
 
 fn counters_text(w: &WorkloadResult) -> String {
-    match &w.counters_per_ray {
+    match &w.counters_per_query {
         None => "none".into(),
         Some(c) => format!(
             "nodes {:.3}, leaves {:.3}, prim tests {:.3}, cells {:.3}, mailbox skips {:.3} per {}",
@@ -416,8 +416,8 @@ fn row(
             _ => "CHANGED",
         },
         mismatches: (
-            bw.validation.counts.mismatch + bw.validation.counted_path_differs,
-            nw.validation.counts.mismatch + nw.validation.counted_path_differs,
+            bw.agreement.counts.mismatch + bw.agreement.counted_path_differs,
+            nw.agreement.counts.mismatch + nw.agreement.counted_path_differs,
         ),
     }
 }

@@ -4,7 +4,7 @@
 //! (serde_json writes non-finite floats as `null` and then cannot read them back), and exact
 //! ray and hit values are carried as hex bit patterns so a disputed ray can be replayed.
 
-use super::agreement::Validation;
+use super::agreement::Agreement;
 use super::write_json_atomic;
 use crate::env::Environment;
 use raybench_accel::classify::Tolerance;
@@ -13,8 +13,12 @@ use raybench_geom::RemovedTriangles;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// Bumped whenever a field changes meaning or disappears.
-pub const SCHEMA_VERSION: u32 = 1;
+/// Bumped whenever a field changes meaning, is renamed or disappears.
+pub const SCHEMA_VERSION: u32 = 2;
+
+/// The oldest schema version still read (version 1 through the old names of the fields of
+/// [`WorkloadResult`] and [`WorkloadRecord`]).
+pub const OLDEST_READABLE: u32 = 1;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Report {
@@ -65,8 +69,9 @@ pub struct SceneRecord {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WorkloadRecord {
     pub workload: String,
-    /// Queries: rays, or query points for a point workload.
-    pub rays: usize,
+    /// Rays, or query points for a point workload.
+    #[serde(alias = "rays")]
+    pub queries: usize,
     pub any_hit: bool,
     /// A closest-point workload (`points-near`, `points-volume`), asked with an infinite radius.
     #[serde(default)]
@@ -122,31 +127,36 @@ pub struct Throughput {
     pub runs: usize,
 }
 
-/// One structure on one workload. For a closest-point workload (`point_query`), `rays` counts
-/// query points, `mrays_per_s` is millions of queries per second, `counters_per_ray` is per
-/// query (`prim_tests` = point–triangle distance tests) and the validation classes count
-/// queries (`both_miss` = neither found a triangle).
+/// One structure on one workload. A query is a ray in a ray workload and a point in a
+/// closest-point workload (`point_query`): there `prim_tests` counts point–triangle distance
+/// tests and `both_miss` means neither side found a triangle. Reports of schema version 1 named
+/// four fields after rays (`rays`, `mrays_per_s`, `counters_per_ray`, `validation`); they are
+/// read under those names too.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WorkloadResult {
     pub workload: String,
-    /// Queries: rays, or query points for a point workload.
-    pub rays: usize,
+    /// Rays, or query points for a point workload.
+    #[serde(alias = "rays")]
+    pub queries: usize,
     pub any_hit: bool,
     /// True for a closest-point workload (absent in older reports: false).
     #[serde(default)]
     pub point_query: bool,
     /// Millions of queries per second: rays, or closest-point queries when `point_query`.
-    pub mrays_per_s: Throughput,
+    #[serde(alias = "mrays_per_s")]
+    pub mqueries_per_s: Throughput,
     /// Median throughput divided by the reference's in this run (> 1: faster than reference).
     pub speedup_vs_reference: Option<f64>,
     /// `None` for structures that cannot count their work (Embree).
-    pub counters_per_ray: Option<CountersPerRay>,
+    #[serde(alias = "counters_per_ray")]
+    pub counters_per_query: Option<CountersPerQuery>,
     pub counters_total: Option<Counters>,
-    pub validation: Validation,
+    #[serde(alias = "validation")]
+    pub agreement: Agreement,
 }
 
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
-pub struct CountersPerRay {
+pub struct CountersPerQuery {
     pub nodes: f64,
     pub leaves: f64,
     pub prim_tests: f64,
@@ -154,10 +164,10 @@ pub struct CountersPerRay {
     pub mailbox_skips: f64,
 }
 
-impl CountersPerRay {
-    pub fn from_total(c: &Counters, rays: usize) -> CountersPerRay {
-        let n = rays.max(1) as f64;
-        CountersPerRay {
+impl CountersPerQuery {
+    pub fn from_total(c: &Counters, queries: usize) -> CountersPerQuery {
+        let n = queries.max(1) as f64;
+        CountersPerQuery {
             nodes: c.nodes as f64 / n,
             leaves: c.leaves as f64 / n,
             prim_tests: c.prim_tests as f64 / n,
@@ -180,11 +190,11 @@ impl Report {
         let report: Report = serde_json::from_slice(&bytes)
             .with_context(|| format!("parsing {}", path.display()))?;
         anyhow::ensure!(
-            report.schema_version == SCHEMA_VERSION,
-            "{}: schema_version {} is not the supported {}",
+            (OLDEST_READABLE..=SCHEMA_VERSION).contains(&report.schema_version),
+            "{}: schema_version {} is not one this raybench reads ({OLDEST_READABLE} to \
+             {SCHEMA_VERSION})",
             path.display(),
             report.schema_version,
-            SCHEMA_VERSION
         );
         Ok(report)
     }
@@ -194,7 +204,7 @@ impl Report {
         self.results
             .iter()
             .flat_map(|r| &r.workloads)
-            .map(|w| w.validation.counts.mismatch + w.validation.counted_path_differs)
+            .map(|w| w.agreement.counts.mismatch + w.agreement.counted_path_differs)
             .sum()
     }
 }
@@ -206,7 +216,7 @@ pub fn is_point_workload(workload: &str) -> bool {
         .is_ok_and(|w| w.is_point_query())
 }
 
-/// What a workload's `mrays_per_s` counts: "Mqueries/s" for closest-point workloads,
+/// What a workload's `mqueries_per_s` counts: "Mqueries/s" for closest-point workloads,
 /// "Mrays/s" for ray workloads.
 pub fn throughput_unit(workload: &str) -> &'static str {
     if is_point_workload(workload) {

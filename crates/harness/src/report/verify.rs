@@ -1,6 +1,6 @@
 //! `verify.json`: the schema of what `raybench verify` writes, and reading it back.
 
-use super::agreement::Validation;
+use super::agreement::Agreement;
 use super::run::TriangleCounts;
 use super::write_json_atomic;
 use crate::env::Environment;
@@ -9,8 +9,12 @@ use raybench_accel::classify::{Tolerance, VerdictCounts};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// Bumped whenever a field of `verify.json` changes meaning or disappears.
-pub const VERIFY_SCHEMA_VERSION: u32 = 1;
+/// Bumped whenever a field of `verify.json` changes meaning, is renamed or disappears.
+pub const VERIFY_SCHEMA_VERSION: u32 = 2;
+
+/// The oldest version still read (version 1 through the old names: `rays`,
+/// `brute_force_rays`, `validations`).
+pub const VERIFY_OLDEST_READABLE: u32 = 1;
 
 /// `verify.json`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -20,7 +24,7 @@ pub struct VerifyReport {
     pub environment: Environment,
     pub settings: VerifySettings,
     pub scenes: Vec<VerifiedScene>,
-    /// One entry per scene × structure × workload, with one validation per reference.
+    /// One entry per scene × structure × workload, with one agreement record per reference.
     pub results: Vec<VerifiedWorkload>,
     /// Per structure × reference, summed over scenes and workloads (what the table prints).
     pub totals: Vec<AgreementRow>,
@@ -58,9 +62,12 @@ pub struct VerifiedScene {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SampledWorkload {
     pub workload: String,
-    pub rays: usize,
-    /// Rays the `bruteforce` reference checked (evenly spaced; all when affordable).
-    pub brute_force_rays: usize,
+    /// Rays, or query points for a point workload.
+    #[serde(alias = "rays")]
+    pub queries: usize,
+    /// Queries the `bruteforce` reference checked (evenly spaced; all when affordable).
+    #[serde(alias = "brute_force_rays")]
+    pub brute_force_queries: usize,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -69,21 +76,25 @@ pub struct VerifiedWorkload {
     pub structure: String,
     pub workload: String,
     pub any_hit: bool,
-    /// Rays this structure traced: every ray, or the brute-force subsample for brute force.
-    pub rays: usize,
+    /// Queries this structure answered: every one, or the brute-force subsample for brute
+    /// force.
+    #[serde(alias = "rays")]
+    pub queries: usize,
     pub subsampled: bool,
-    /// Rays where the counted path answered differently from the timed path (a bug).
+    /// Queries where the counted path answered differently from the timed path (a bug).
     pub counted_path_differs: u64,
-    /// One per reference, in [`REFERENCES`] order. Disputed rays carry their index in the
-    /// workload's full ray list.
-    pub validations: Vec<Validation>,
+    /// One per reference, in [`crate::pipeline::verify::REFERENCES`] order. Disputed queries
+    /// carry their index in the workload's full list.
+    #[serde(alias = "validations")]
+    pub agreements: Vec<Agreement>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AgreementRow {
     pub structure: String,
     pub reference: String,
-    pub rays: u64,
+    #[serde(alias = "rays")]
+    pub queries: u64,
     #[serde(flatten)]
     pub counts: VerdictCounts,
     pub counted_path_differs: u64,
@@ -99,8 +110,7 @@ impl VerifyReport {
         self.results
             .iter()
             .map(|r| {
-                r.counted_path_differs
-                    + r.validations.iter().map(|v| v.counts.mismatch).sum::<u64>()
+                r.counted_path_differs + r.agreements.iter().map(|v| v.counts.mismatch).sum::<u64>()
             })
             .sum()
     }
@@ -115,8 +125,9 @@ impl VerifyReport {
         let report: VerifyReport = serde_json::from_slice(&bytes)
             .with_context(|| format!("parsing {}", path.display()))?;
         ensure!(
-            report.schema_version == VERIFY_SCHEMA_VERSION,
-            "{}: schema_version {} is not the supported {VERIFY_SCHEMA_VERSION}",
+            (VERIFY_OLDEST_READABLE..=VERIFY_SCHEMA_VERSION).contains(&report.schema_version),
+            "{}: schema_version {} is not one this raybench reads ({VERIFY_OLDEST_READABLE} to \
+             {VERIFY_SCHEMA_VERSION})",
             path.display(),
             report.schema_version
         );

@@ -85,7 +85,7 @@ pub(super) fn all_charts(report: &Report) -> Result<Vec<(String, String, String)
                 format!("{wl}: {unit}"),
                 &format!("{unit} (median)"),
                 true,
-                |r| find(r).map(|w| w.mrays_per_s.median),
+                |r| find(r).map(|w| w.mqueries_per_s.median),
             ),
         )?;
         push(
@@ -111,13 +111,13 @@ pub(super) fn all_charts(report: &Report) -> Result<Vec<(String, String, String)
     )?;
 
     for wl in workload_names(report) {
-        let per_ray = |f: fn(&crate::report::run::CountersPerRay) -> f64| {
+        let per_ray = |f: fn(&crate::report::run::CountersPerQuery) -> f64| {
             let wl = wl.clone();
             move |r: &ResultEntry| {
                 r.workloads
                     .iter()
                     .find(|w| w.workload == wl)
-                    .and_then(|w| w.counters_per_ray.as_ref())
+                    .and_then(|w| w.counters_per_query.as_ref())
                     .map(f)
             }
         };
@@ -170,12 +170,12 @@ pub(super) fn all_charts(report: &Report) -> Result<Vec<(String, String, String)
             ));
         }
     }
-    let validation = validation_chart(report);
-    if validation.has_data() {
+    let agreement = agreement_chart(report);
+    if agreement.has_data() {
         out.push((
             "validation.svg".into(),
             format!("Validation classes per structure against {reference}, all scenes and workloads (log scale)"),
-            charts::bars_svg(&validation, W, H)?,
+            charts::bars_svg(&agreement, W, H)?,
         ));
     }
     Ok(out)
@@ -184,7 +184,7 @@ pub(super) fn all_charts(report: &Report) -> Result<Vec<(String, String, String)
 /// How many rays of a validation class.
 type ClassCount = fn(&raybench_accel::classify::VerdictCounts) -> u64;
 
-fn validation_chart(report: &Report) -> Bars {
+fn agreement_chart(report: &Report) -> Bars {
     let structures = structure_names(report);
     let classes: [(&str, ClassCount); 5] = [
         ("agree (both miss, exact, within tolerance)", |c| {
@@ -207,7 +207,7 @@ fn validation_chart(report: &Report) -> Bars {
                         .iter()
                         .filter(|r| &r.structure == st)
                         .flat_map(|r| &r.workloads)
-                        .map(|w| f(&w.validation.counts))
+                        .map(|w| f(&w.agreement.counts))
                         .sum();
                     (n > 0).then_some(n as f64)
                 })

@@ -53,11 +53,11 @@ pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictu
             .results
             .iter()
             .flat_map(|r| &r.workloads)
-            .map(|w| w.validation.rays())
+            .map(|w| w.agreement.queries())
             .sum::<u64>()
     );
     results_table(&mut s, report);
-    validation_table(&mut s, report);
+    agreement_table(&mut s, report);
     s.push_str("<h2>Charts</h2>\n");
     for c in charts {
         let _ = writeln!(
@@ -115,7 +115,7 @@ fn results_table(s: &mut String, report: &Report) {
                         let _ = write!(
                             s,
                             "<td>{:.2} ({})</td>",
-                            x.mrays_per_s.median,
+                            x.mqueries_per_s.median,
                             ratio(x.speedup_vs_reference)
                         );
                     }
@@ -125,7 +125,7 @@ fn results_table(s: &mut String, report: &Report) {
             let bad: u64 = r
                 .workloads
                 .iter()
-                .map(|w| w.validation.counts.mismatch + w.validation.counted_path_differs)
+                .map(|w| w.agreement.counts.mismatch + w.agreement.counted_path_differs)
                 .sum();
             let _ = writeln!(
                 s,
@@ -141,7 +141,7 @@ fn ratio(r: Option<f64>) -> String {
     r.map_or("-".into(), |r| format!("{r:.2}×"))
 }
 
-fn validation_table(s: &mut String, report: &Report) {
+fn agreement_table(s: &mut String, report: &Report) {
     s.push_str(
         "<h2>Validation</h2>\n<table><tr><th class=\"l\">structure</th><th>rays</th><th>both miss</th>\
          <th>exact</th><th>within tolerance</th><th>tie</th><th>boundary</th><th>edge ambiguous</th>\
@@ -156,8 +156,8 @@ fn validation_table(s: &mut String, report: &Report) {
             .filter(|r| r.structure == st)
             .flat_map(|r| &r.workloads)
         {
-            c += w.validation.counts;
-            differs += w.validation.counted_path_differs;
+            c += w.agreement.counts;
+            differs += w.agreement.counted_path_differs;
         }
         let _ = writeln!(
             s,

@@ -67,9 +67,9 @@ pub(super) fn scaling_chart(report: &Report) -> Result<Option<String>> {
                 .workloads
                 .iter()
                 .find(|w| Some(&w.workload) == wl.as_ref())
-                && w.mrays_per_s.median > 0.0
+                && w.mqueries_per_s.median > 0.0
             {
-                t.push((n, 1e3 / w.mrays_per_s.median));
+                t.push((n, 1e3 / w.mqueries_per_s.median));
             }
         }
         b.sort_by(|x, y| x.0.total_cmp(&y.0));
@@ -150,7 +150,7 @@ pub(super) fn break_even_chart(report: &Report, scene: &str) -> Result<Option<St
         .filter(|r| r.scene == scene)
         .filter_map(|r| {
             let w = r.workloads.iter().find(|w| w.workload == wl)?;
-            let rate = w.mrays_per_s.median * 1e6;
+            let rate = w.mqueries_per_s.median * 1e6;
             (rate > 0.0).then(|| {
                 let build_s = r.build.median_ms / 1e3;
                 (

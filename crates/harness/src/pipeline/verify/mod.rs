@@ -27,7 +27,7 @@ use super::workers::{Log, Progress, Workers, catch_panic};
 use crate::env::Environment;
 use crate::output::agreement::agreement_sentence;
 use crate::registry::{self, StructureEntry};
-use crate::report::agreement::Validation;
+use crate::report::agreement::Agreement;
 use crate::report::verify::{
     AgreementRow, SampledWorkload, VERIFY_SCHEMA_VERSION, VerifiedScene, VerifiedWorkload,
     VerifyReport, VerifySettings,
@@ -198,8 +198,8 @@ fn verify_scene(
             .zip(&refs.workloads)
             .map(|(wl, wr)| SampledWorkload {
                 workload: wl.workload.name().to_string(),
-                rays: wl.rays.len(),
-                brute_force_rays: wr.sample.len(),
+                queries: wl.rays.len(),
+                brute_force_queries: wr.sample.len(),
             })
             .chain(point_samples(&refs))
             .collect(),
@@ -220,8 +220,8 @@ fn point_samples<'r>(refs: &'r SceneReferences<'_>) -> impl Iterator<Item = Samp
         .zip(&refs.point_workloads)
         .map(|(pw, pr)| SampledWorkload {
             workload: pw.workload.name().to_string(),
-            rays: pw.points.len(),
-            brute_force_rays: pr.sample.len(),
+            queries: pw.points.len(),
+            brute_force_queries: pr.sample.len(),
         })
 }
 
@@ -229,7 +229,7 @@ fn point_samples<'r>(refs: &'r SceneReferences<'_>) -> impl Iterator<Item = Samp
 fn totals(results: &[VerifiedWorkload]) -> Vec<AgreementRow> {
     let mut rows: Vec<AgreementRow> = Vec::new();
     for r in results {
-        for v in &r.validations {
+        for v in &r.agreements {
             let i = match rows
                 .iter()
                 .position(|x| x.structure == r.structure && x.reference == v.reference)
@@ -239,7 +239,7 @@ fn totals(results: &[VerifiedWorkload]) -> Vec<AgreementRow> {
                     rows.push(AgreementRow {
                         structure: r.structure.clone(),
                         reference: v.reference.clone(),
-                        rays: 0,
+                        queries: 0,
                         counts: VerdictCounts::default(),
                         counted_path_differs: 0,
                         mismatch_rate_upper95: 0.0,
@@ -253,8 +253,8 @@ fn totals(results: &[VerifiedWorkload]) -> Vec<AgreementRow> {
         }
     }
     for row in &mut rows {
-        let v = Validation::new(&row.reference, row.counts);
-        row.rays = row.counts.total();
+        let v = Agreement::new(&row.reference, row.counts);
+        row.queries = row.counts.total();
         row.mismatch_rate_upper95 = v.mismatch_rate_upper95;
         row.agreement = agreement_sentence(&row.counts);
     }

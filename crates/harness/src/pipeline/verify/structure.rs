@@ -6,14 +6,14 @@ use super::references::{
 };
 use super::{REFERENCES, VerifyOptions};
 use crate::pipeline::check::{
-    Sides, count_differences, count_point_differences, validate, validate_points,
+    Sides, check_answers, check_points, counted_path_differences, counted_point_differences,
 };
 use crate::pipeline::dump::DumpDir;
 use crate::pipeline::measure::{Answers, count_pass, count_point_pass, point_pass, trace_pass};
 use crate::pipeline::workers::Progress;
 use crate::pipeline::workloads::{PreparedPoints, PreparedWorkload, prepare_workload};
 use crate::registry::{BuildContext, StructureEntry};
-use crate::report::agreement::Validation;
+use crate::report::agreement::Agreement;
 use crate::report::verify::VerifiedWorkload;
 use anyhow::Result;
 use raybench_accel::classify::Tolerance;
@@ -56,7 +56,7 @@ impl Checker<'_> {
                 accel: built.accel.as_ref(),
                 sampled: entry.is_exhaustive() && wr.sample.len() < wl.rays.len(),
             };
-            let (result, traced) = self.check_workload(&subject, refs, wl, wr)?;
+            let (result, traced) = self.check_ray_workload(&subject, refs, wl, wr)?;
             if let Some(d) = dump.as_deref_mut() {
                 let indices = subject.sampled.then_some(&wr.sample[..]);
                 let rays = maybe_gather(&wl.rays, indices);
@@ -79,7 +79,7 @@ impl Checker<'_> {
                     accel: built.accel.as_ref(),
                     sampled,
                 };
-                out.push(self.check_points(&subject, refs, pw, pr));
+                out.push(self.check_point_workload(&subject, refs, pw, pr));
             }
         }
         Ok(out)
@@ -87,7 +87,7 @@ impl Checker<'_> {
 
     /// The subject's timed and counted closest points, compared with each other and with every
     /// reference (on the brute-force subsample where either side answered only that).
-    fn check_points(
+    fn check_point_workload(
         &self,
         subject: &Subject<'_>,
         refs: &SceneReferences<'_>,
@@ -105,9 +105,9 @@ impl Checker<'_> {
             &mut timed,
         );
         let (counted, _) = count_point_pass(subject.accel, &points, pw.radius);
-        let differs = count_point_differences(&timed, &counted);
+        let differs = counted_point_differences(&timed, &counted);
         let mesh = &refs.run.scene.scene.mesh;
-        let compare = |name: &str, theirs: &[Option<PointHit>], theirs_on_sample: bool| {
+        let classify_against = |name: &str, theirs: &[Option<PointHit>], theirs_on_sample: bool| {
             let on_sample = subject.sampled || theirs_on_sample;
             let narrow = |answers: &[Option<PointHit>], already: bool| {
                 if on_sample && !already {
@@ -119,7 +119,7 @@ impl Checker<'_> {
             let ours = narrow(&timed, subject.sampled);
             let theirs = narrow(theirs, theirs_on_sample);
             let queried = maybe_gather(&pw.points, on_sample.then_some(&pr.sample[..]));
-            let mut v = validate_points(mesh, &queried, pw.radius, &ours, &theirs, name);
+            let mut v = check_points(mesh, &queried, pw.radius, &ours, &theirs, name);
             if on_sample {
                 v.first_point_mismatches
                     .iter_mut()
@@ -133,20 +133,20 @@ impl Checker<'_> {
             structure: subject.name.to_string(),
             workload: pw.workload.name().to_string(),
             any_hit: false,
-            rays: points.len(),
+            queries: points.len(),
             subsampled: subject.sampled,
             counted_path_differs: differs,
-            validations: vec![
-                compare(REFERENCES[0], &pw.reference, false),
-                compare(REFERENCES[1], &pr.robust, false),
-                compare(REFERENCES[2], &pr.brute, true),
+            agreements: vec![
+                classify_against(REFERENCES[0], &pw.reference, false),
+                classify_against(REFERENCES[1], &pr.robust, false),
+                classify_against(REFERENCES[2], &pr.brute, true),
             ],
         }
     }
 
     /// The subject's timed and counted answers, compared with each other and with every
     /// reference. Also returns the timed answers (for the dump).
-    fn check_workload(
+    fn check_ray_workload(
         &self,
         subject: &Subject<'_>,
         refs: &SceneReferences<'_>,
@@ -164,56 +164,57 @@ impl Checker<'_> {
             self.opts.threads,
         )?;
         let mesh = &refs.run.scene.scene.mesh;
-        let paths = count_differences(mesh, &rays, &timed, &counted, &self.tol);
+        let paths = counted_path_differences(mesh, &rays, &timed, &counted, &self.tol);
         let differs = paths.differs;
-        let compare = |reference: (&str, &dyn Accel), theirs: &Answers, on_sample: bool| {
-            // `on_sample`: the reference answered the subsample only; the subject's answers
-            // are narrowed to it unless they already are.
-            let narrow = on_sample && !subject.sampled && wr.sample.len() < wl.rays.len();
-            let indices = if narrow {
-                Some(&wr.sample[..])
-            } else {
-                own_indices
-            };
-            let (rays, ours) = if narrow {
-                (
-                    Cow::Owned(gather(&rays, &wr.sample)),
-                    Cow::Owned(timed.gather(&wr.sample)),
+        let classify_against =
+            |reference: (&str, &dyn Accel), theirs: &Answers, on_sample: bool| {
+                // `on_sample`: the reference answered the subsample only; the subject's answers
+                // are narrowed to it unless they already are.
+                let narrow = on_sample && !subject.sampled && wr.sample.len() < wl.rays.len();
+                let indices = if narrow {
+                    Some(&wr.sample[..])
+                } else {
+                    own_indices
+                };
+                let (rays, ours) = if narrow {
+                    (
+                        Cow::Owned(gather(&rays, &wr.sample)),
+                        Cow::Owned(timed.gather(&wr.sample)),
+                    )
+                } else {
+                    (Cow::Borrowed(&rays[..]), Cow::Borrowed(&timed))
+                };
+                let theirs = match (own_indices, on_sample) {
+                    (Some(idx), false) => Cow::Owned(theirs.gather(idx)),
+                    _ => Cow::Borrowed(theirs),
+                };
+                let sides = Sides {
+                    ours: subject.accel,
+                    reference: reference.1,
+                    reference_name: reference.0,
+                };
+                check_against(
+                    mesh, &rays, &ours, &theirs, &sides, &self.tol, indices, differs,
                 )
-            } else {
-                (Cow::Borrowed(&rays[..]), Cow::Borrowed(&timed))
             };
-            let theirs = match (own_indices, on_sample) {
-                (Some(idx), false) => Cow::Owned(theirs.gather(idx)),
-                _ => Cow::Borrowed(theirs),
-            };
-            let sides = Sides {
-                ours: subject.accel,
-                reference: reference.1,
-                reference_name: reference.0,
-            };
-            comparison(
-                mesh, &rays, &ours, &theirs, &sides, &self.tol, indices, differs,
-            )
-        };
-        let validations = vec![
-            compare(
+        let agreements = vec![
+            classify_against(
                 (REFERENCES[0], refs.run.reference.as_ref()),
                 &wl.reference,
                 false,
             ),
-            compare((REFERENCES[1], refs.robust.as_ref()), &wr.robust, false),
-            compare((REFERENCES[2], refs.brute.as_ref()), &wr.brute, true),
+            classify_against((REFERENCES[1], refs.robust.as_ref()), &wr.robust, false),
+            classify_against((REFERENCES[2], refs.brute.as_ref()), &wr.brute, true),
         ];
         let result = VerifiedWorkload {
             scene: refs.run.scene.scene.name.clone(),
             structure: subject.name.to_string(),
             workload: wl.workload.name().to_string(),
             any_hit,
-            rays: rays.len(),
+            queries: rays.len(),
             subsampled: subject.sampled,
             counted_path_differs: differs,
-            validations,
+            agreements,
         };
         Ok((result, timed))
     }
@@ -230,7 +231,7 @@ struct Subject<'a> {
 /// Validates `ours` against `theirs` on `rays`; disputed rays get their index in the full
 /// workload (`indices[k]` for the k-th of a subsample).
 #[allow(clippy::too_many_arguments)]
-fn comparison(
+fn check_against(
     mesh: &TriangleMesh,
     rays: &[Ray],
     ours: &Answers,
@@ -239,8 +240,8 @@ fn comparison(
     tol: &Tolerance,
     indices: Option<&[usize]>,
     counted_path_differs: u64,
-) -> Validation {
-    let (mut v, _levels) = validate(mesh, rays, ours, theirs, sides, tol);
+) -> Agreement {
+    let (mut v, _levels) = check_answers(mesh, rays, ours, theirs, sides, tol);
     if let Some(idx) = indices {
         for d in v.first_mismatches.iter_mut().chain(&mut v.first_ambiguous) {
             d.index = idx[d.index];
