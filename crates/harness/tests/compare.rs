@@ -121,7 +121,7 @@ fn a_missing_structure_is_a_regression() {
 fn different_settings_and_machines_are_flagged() {
     let mut new = base().clone();
     new.run.seed += 1;
-    new.environment.cpu_model = "Another CPU".into();
+    new.header.environment.cpu_model = "Another CPU".into();
     let c = compare(base(), &new, &CompareOptions::default());
     assert!(
         c.markdown.contains("WARNING: different environments (CPU"),
@@ -222,9 +222,9 @@ fn a_schema_1_report_reads_through_the_old_names() {
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.contains("\"mrays_per_s\"") && !text.contains("\"mqueries_per_s\""));
     let read = Report::read(&path).expect("a schema-1 report reads");
-    assert_eq!(read.schema_version, 1);
+    assert_eq!(read.header.schema_version, 1);
     let mut same = read.clone();
-    same.schema_version = base().schema_version;
+    same.header.schema_version = base().header.schema_version;
     assert_eq!(
         serde_json::to_string(&same).unwrap(),
         serde_json::to_string(base()).unwrap()

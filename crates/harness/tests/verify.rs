@@ -304,8 +304,8 @@ fn a_schema_1_verify_json_reads_through_the_old_names() {
             .contains("\"validations\"")
     );
     let mut read = VerifyReport::read(&path).expect("a schema-1 verify.json reads");
-    assert_eq!(read.schema_version, 1);
-    read.schema_version = report().schema_version;
+    assert_eq!(read.header.schema_version, 1);
+    read.header.schema_version = report().header.schema_version;
     assert_eq!(
         serde_json::to_string(&read).unwrap(),
         serde_json::to_string(report()).unwrap()

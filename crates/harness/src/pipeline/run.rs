@@ -17,6 +17,7 @@ use super::scenes::for_each_scene;
 use super::workers::{Log, Progress, Workers, catch_panic};
 use super::workloads::{PreparedPoints, QueryCounts, SceneRun, prepare_workload, triangle_counts};
 use crate::registry::{self, BuildContext, StructureEntry};
+use crate::report::Header;
 use crate::report::run::*;
 use anyhow::Result;
 use raybench_accel::Accel;
@@ -74,9 +75,7 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
         (scenes.len() * (structures.len() + 1)) as u64,
     );
     let mut report = Report {
-        schema_version: SCHEMA_VERSION,
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        environment: workers.environment.clone(),
+        header: Header::new(SCHEMA_VERSION, workers.environment.clone()),
         run: RunSettings {
             suite: opts.suite.clone(),
             seed: opts.seed,

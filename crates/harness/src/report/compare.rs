@@ -90,8 +90,9 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
     }
     // Shadow, diffuse and Whitted rays are generated from the reference's hits: with another
     // Embree build or ISA they may differ by an ulp, and so may the counters they produce.
-    let same_embree = base.environment.embree.version == new.environment.embree.version
-        && base.environment.embree.isa == new.environment.embree.isa;
+    let same_embree = base.header.environment.embree.version
+        == new.header.environment.embree.version
+        && base.header.environment.embree.isa == new.header.environment.embree.isa;
     let (b, n) = (keyed(base), keyed(new));
     let mut rows = Vec::new();
     for (key, be) in &b {
@@ -152,7 +153,7 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
 /// Warns about different machines and settings; returns whether deterministic figures are
 /// comparable (same seed, rays, workloads, suite and reference).
 fn environment_warnings(base: &Report, new: &Report, findings: &mut Vec<Finding>) -> bool {
-    let (be, ne) = (&base.environment, &new.environment);
+    let (be, ne) = (&base.header.environment, &new.header.environment);
     let machine = [
         ("CPU", be.cpu_model.clone(), ne.cpu_model.clone()),
         ("cores", be.cores.to_string(), ne.cores.to_string()),
@@ -447,10 +448,10 @@ fn markdown(
     let _ = writeln!(
         s,
         "## raybench compare\n\nbase: {} ({}), new: {} ({})\n",
-        base.environment.git_revision,
-        base.environment.timestamp,
-        new.environment.git_revision,
-        new.environment.timestamp
+        base.header.environment.git_revision,
+        base.header.environment.timestamp,
+        new.header.environment.git_revision,
+        new.header.environment.timestamp
     );
     let _ = writeln!(
         s,

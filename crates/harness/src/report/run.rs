@@ -5,8 +5,7 @@
 //! ray and hit values are carried as hex bit patterns so a disputed ray can be replayed.
 
 use super::agreement::Agreement;
-use super::write_json_atomic;
-use crate::env::Environment;
+use super::{Header, read_report, write_json_atomic};
 use raybench_accel::classify::Tolerance;
 use raybench_accel::{BuildStats, Counters, Memory};
 use raybench_geom::RemovedTriangles;
@@ -22,9 +21,8 @@ pub const OLDEST_READABLE: u32 = 1;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Report {
-    pub schema_version: u32,
-    pub tool_version: String,
-    pub environment: Environment,
+    #[serde(flatten)]
+    pub header: Header,
     pub run: RunSettings,
     pub scenes: Vec<SceneRecord>,
     pub results: Vec<ResultEntry>,
@@ -185,18 +183,7 @@ impl Report {
     }
 
     pub fn read(path: &Path) -> anyhow::Result<Report> {
-        use anyhow::Context;
-        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-        let report: Report = serde_json::from_slice(&bytes)
-            .with_context(|| format!("parsing {}", path.display()))?;
-        anyhow::ensure!(
-            (OLDEST_READABLE..=SCHEMA_VERSION).contains(&report.schema_version),
-            "{}: schema_version {} is not one this raybench reads ({OLDEST_READABLE} to \
-             {SCHEMA_VERSION})",
-            path.display(),
-            report.schema_version,
-        );
-        Ok(report)
+        read_report(path, OLDEST_READABLE..=SCHEMA_VERSION)
     }
 
     /// Total mismatches over every structure, scene and workload.

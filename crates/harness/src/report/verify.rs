@@ -2,9 +2,8 @@
 
 use super::agreement::Agreement;
 use super::run::TriangleCounts;
-use super::write_json_atomic;
-use crate::env::Environment;
-use anyhow::{Context, Result, ensure};
+use super::{Header, read_report, write_json_atomic};
+use anyhow::Result;
 use raybench_accel::classify::{Tolerance, VerdictCounts};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -19,9 +18,8 @@ pub const VERIFY_OLDEST_READABLE: u32 = 1;
 /// `verify.json`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct VerifyReport {
-    pub schema_version: u32,
-    pub tool_version: String,
-    pub environment: Environment,
+    #[serde(flatten)]
+    pub header: Header,
     pub settings: VerifySettings,
     pub scenes: Vec<VerifiedScene>,
     /// One entry per scene × structure × workload, with one agreement record per reference.
@@ -121,16 +119,6 @@ impl VerifyReport {
     }
 
     pub fn read(path: &Path) -> Result<VerifyReport> {
-        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-        let report: VerifyReport = serde_json::from_slice(&bytes)
-            .with_context(|| format!("parsing {}", path.display()))?;
-        ensure!(
-            (VERIFY_OLDEST_READABLE..=VERIFY_SCHEMA_VERSION).contains(&report.schema_version),
-            "{}: schema_version {} is not one this raybench reads ({VERIFY_OLDEST_READABLE} to \
-             {VERIFY_SCHEMA_VERSION})",
-            path.display(),
-            report.schema_version
-        );
-        Ok(report)
+        read_report(path, VERIFY_OLDEST_READABLE..=VERIFY_SCHEMA_VERSION)
     }
 }

@@ -1,7 +1,6 @@
 //! `watertight.json`: the schema of what `raybench watertight` writes.
 
-use super::write_json_atomic;
-use crate::env::Environment;
+use super::{Header, write_json_atomic};
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -19,11 +18,14 @@ pub struct Case {
     pub shift: [f64; 3],
 }
 
+/// Bumped whenever a field of `watertight.json` changes meaning, is renamed or disappears.
+pub const WATERTIGHT_SCHEMA_VERSION: u32 = 1;
+
 /// `watertight.json`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WatertightReport {
-    pub tool_version: String,
-    pub environment: Environment,
+    #[serde(flatten)]
+    pub header: Header,
     pub seed: u64,
     pub embree_robust_bar: f64,
     pub cases: Vec<CaseRecord>,

@@ -24,7 +24,7 @@ img.px{image-rendering:pixelated;width:240px;border:1px solid #ddd}\
 
 pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictures]) -> String {
     let mut s = String::new();
-    let env = &report.environment;
+    let env = &report.header.environment;
     let title = match &report.run.suite {
         Some(suite) => format!("raybench: suite {suite}"),
         None => "raybench report".to_string(),
@@ -234,7 +234,7 @@ fn notes(s: &mut String, report: &Report) {
 
 fn environment(s: &mut String, report: &Report) {
     s.push_str("<h2>Environment</h2>\n<table>\n");
-    let env = serde_json::to_value(&report.environment).unwrap_or_default();
+    let env = serde_json::to_value(&report.header.environment).unwrap_or_default();
     let run = serde_json::to_value(&report.run).unwrap_or_default();
     for (section, value) in [("environment", env), ("run", run)] {
         if let serde_json::Value::Object(map) = value {

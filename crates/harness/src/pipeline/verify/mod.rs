@@ -27,6 +27,7 @@ use super::workers::{Log, Progress, Workers, catch_panic};
 use crate::env::Environment;
 use crate::output::agreement::agreement_sentence;
 use crate::registry::{self, StructureEntry};
+use crate::report::Header;
 use crate::report::agreement::Agreement;
 use crate::report::verify::{
     AgreementRow, SampledWorkload, VERIFY_SCHEMA_VERSION, VerifiedScene, VerifiedWorkload,
@@ -143,9 +144,7 @@ fn empty_report(
     tolerance: Tolerance,
 ) -> VerifyReport {
     VerifyReport {
-        schema_version: VERIFY_SCHEMA_VERSION,
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        environment,
+        header: Header::new(VERIFY_SCHEMA_VERSION, environment),
         settings: VerifySettings {
             suite: opts.suite.clone(),
             seed: opts.seed,

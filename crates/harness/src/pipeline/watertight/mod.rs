@@ -22,8 +22,10 @@ use super::measure::{Answers, trace_pass};
 use super::verify::brute_force_sample;
 use super::workers::{Workers, catch_panic};
 use crate::registry::{self, BuildContext, StructureEntry};
+use crate::report::Header;
 use crate::report::watertight::{
-    Case, CaseRecord, EMBREE_ROBUST_BAR, MissRate, Tally, WatertightReport,
+    Case, CaseRecord, EMBREE_ROBUST_BAR, MissRate, Tally, WATERTIGHT_SCHEMA_VERSION,
+    WatertightReport,
 };
 use aimed::{AimedRays, aimed_rays};
 use anyhow::{Context, Result, ensure};
@@ -125,8 +127,7 @@ pub fn watertight(opts: &WatertightOptions) -> Result<WatertightReport> {
     let entries = registry::select(&opts.structures)?;
     let workers = Workers::start(opts.threads, false)?;
     let mut report = WatertightReport {
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        environment: workers.environment.clone(),
+        header: Header::new(WATERTIGHT_SCHEMA_VERSION, workers.environment.clone()),
         seed: opts.seed,
         embree_robust_bar: EMBREE_ROBUST_BAR,
         cases: Vec::new(),
