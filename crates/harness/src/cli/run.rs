@@ -35,7 +35,7 @@ pub struct RunArgs {
     /// Leave the per-pixel pictures of primary rays out of the report (smaller; for baselines).
     #[arg(long)]
     no_images: bool,
-    /// Write every ray and each structure's answer here (see README, "Hit dumps").
+    /// Write every ray and each structure's answer here (see docs/report-format.md, "Hit dumps").
     #[arg(long)]
     dump_hits: Option<PathBuf>,
 }
@@ -53,7 +53,6 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     let sel = &args.selection;
     let opts = RunOptions {
         suite: sel.suite.clone(),
-        scenes: r.requests.iter().map(|r| format!("{r:?}")).collect(),
         structures: r.structures,
         workloads: r.workloads,
         rays: r.rays,

@@ -19,7 +19,7 @@ pub struct VerifyArgs {
     /// Output directory for verify.json (default: reports/<date>-<revision>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write every ray and each structure's answer here (see README, "Hit dumps").
+    /// Write every ray and each structure's answer here (see docs/report-format.md, "Hit dumps").
     #[arg(long)]
     pub dump_hits: Option<PathBuf>,
     /// Ray–triangle tests brute force may spend per scene × workload (it checks an evenly

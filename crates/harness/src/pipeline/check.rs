@@ -11,14 +11,14 @@ use raybench_geom::{Ray, TriangleMesh, Vec3};
 /// Disputed rays kept per class in the report.
 const KEEP_EXAMPLES: usize = 10;
 
+/// The two structures whose answers are checked against each other (any-hit disagreements
+/// are arbitrated by asking both for their closest hits).
 pub struct Sides<'a> {
     pub ours: &'a dyn Accel,
     pub reference: &'a dyn Accel,
     pub reference_name: &'a str,
 }
 
-/// Classifies every ray; also returns each ray's disagreement level (see [`disagreement`]). Any-hit disagreements are arbitrated through both sides' closest hits,
-/// computed for the disputed rays only.
 impl std::fmt::Debug for Sides<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Sides")
@@ -28,6 +28,9 @@ impl std::fmt::Debug for Sides<'_> {
     }
 }
 
+/// Classifies every ray; also returns each ray's disagreement level (see [`disagreement`]).
+/// Any-hit disagreements are arbitrated through both sides' closest hits, computed for the
+/// disputed rays only.
 pub fn check_answers(
     mesh: &TriangleMesh,
     rays: &[Ray],

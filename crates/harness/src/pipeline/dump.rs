@@ -273,7 +273,7 @@ impl DumpDir {
         let index = DumpIndex {
             format: format!(
                 "raybench hit dump v{VERSION}: {HEADER_BYTES}-byte header, {RECORD_BYTES}-byte \
-                 little-endian records (see README, \"Hit dumps\")"
+                 little-endian records (see docs/report-format.md, \"Hit dumps\")"
             ),
             files: self.files,
         };

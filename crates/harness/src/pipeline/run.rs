@@ -2,8 +2,8 @@
 //! reference, build and time every structure, count, check every answer, and assemble the report.
 //!
 //! Ray workloads and closest-point workloads share the pipeline (build once, warm-up + median
-//! of timed passes, an untimed counted pass, validation against the reference) but not the code
-//! that handles rays: [`SceneRun`] keeps the two kinds in separate lists.
+//! of timed passes, an untimed counted pass, every answer checked against the reference) but
+//! not the code that handles rays: [`SceneRun`] keeps the two kinds in separate lists.
 
 use super::check::{
     Sides, check_answers, check_points, counted_path_differences, counted_point_differences,
@@ -29,8 +29,6 @@ use std::path::PathBuf;
 #[derive(Clone, Debug)]
 pub struct RunOptions {
     pub suite: Option<String>,
-    /// Scene specs (`sphere`, `soup:triangles=5000`) or `.obj` paths.
-    pub scenes: Vec<String>,
     pub structures: Vec<String>,
     pub workloads: Vec<Workload>,
     pub rays: usize,
@@ -239,7 +237,7 @@ impl SceneRun<'_> {
     }
 
     /// One structure on one closest-point workload: timed like rays (warm-up, median of
-    /// `trace_runs` passes on the run's threads), then the counted pass, then validation
+    /// `trace_runs` passes on the run's threads), then the counted pass, then the check
     /// against the reference. Not dumped: `--dump-hits` covers ray workloads only.
     fn measure_points(
         &self,

@@ -9,7 +9,6 @@ use raybench_scenes::Workload;
 pub fn options(structures: &[&str]) -> RunOptions {
     RunOptions {
         suite: None,
-        scenes: vec![],
         structures: structures.iter().map(|s| s.to_string()).collect(),
         workloads: Workload::RAYS.to_vec(),
         rays: 3000,

@@ -1,9 +1,10 @@
 //! `raybench report`: charts, pictures and one static HTML page, drawn from `report.json` alone.
 //!
 //! Output layout under the chosen directory:
-//! * `charts/*.svg` — build time, Mrays/s (Mqueries/s for closest-point workloads) and ratios to the reference per workload, memory per
-//!   triangle, counters per ray, scaling curves with reference slopes (when one scene family
-//!   comes in three or more sizes), break-even per scene, validation classes;
+//! * `charts/*.svg` — build time, Mrays/s (Mqueries/s for closest-point workloads) and ratios
+//!   to the reference per workload, memory per triangle, counters per query, scaling curves
+//!   with reference slopes (when one scene family comes in three or more sizes), break-even per
+//!   scene, validation classes;
 //! * `images/*.png` — per scene and structure: traversal-cost heatmap (one colour scale per
 //!   scene), shaded render, disagreement mask; one legend colour bar;
 //! * `index.html` — tables, the charts, the pictures and the environment; no JavaScript.

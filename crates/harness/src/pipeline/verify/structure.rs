@@ -228,7 +228,7 @@ struct Subject<'a> {
     sampled: bool,
 }
 
-/// Validates `ours` against `theirs` on `rays`; disputed rays get their index in the full
+/// Checks `ours` against `theirs` on `rays`; disputed rays get their index in the full
 /// workload (`indices[k]` for the k-th of a subsample).
 #[allow(clippy::too_many_arguments)]
 fn check_against(
