@@ -28,6 +28,10 @@ enum Command {
     Scene(cli::scene::SceneCommand),
     /// Draw a report: SVG charts, per-pixel PNG pictures and index.html (from report.json alone).
     Report(cli::report::ReportArgs),
+    /// Write a report's figures as a Markdown page: the headline geometric means per structure,
+    /// a table per scene and the SAH costs, linked to the report (--headline-only: the headline
+    /// table and the agreement sentence alone).
+    Results(cli::results::ResultsArgs),
     /// Compare two reports: a Markdown table of changes; exit 2 on a regression (a mismatch
     /// rose, a deterministic figure changed, a timing ratio worsened beyond --max-slowdown).
     Compare(cli::compare::CompareArgs),
@@ -62,6 +66,7 @@ fn main() -> ExitCode {
         Command::Run(args) => cli::run::run(args),
         Command::Scene(cmd) => cli::scene::run(cmd),
         Command::Report(args) => cli::report::run(args),
+        Command::Results(args) => cli::results::run(args),
         Command::Compare(args) => cli::compare::run(args),
         Command::Verify(args) => cli::verify::run(args),
         Command::Replay(args) => cli::replay::run(args),

@@ -7,6 +7,7 @@ pub mod compare;
 pub mod list;
 pub mod replay;
 pub mod report;
+pub mod results;
 pub mod run;
 pub mod scene;
 pub mod verify;

@@ -7,6 +7,7 @@ pub mod png;
 pub mod preview;
 pub mod render;
 pub mod replay_text;
+pub mod results;
 pub mod summary;
 pub mod verify_table;
 pub mod watertight_table;

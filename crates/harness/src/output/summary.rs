@@ -12,7 +12,7 @@ fn ratio(r: Option<f64>) -> String {
 }
 
 /// Three significant digits however small the value (brute force runs at 1e-3 Mrays/s).
-fn sig(x: f64) -> String {
+pub(crate) fn sig(x: f64) -> String {
     if x == 0.0 || x.abs() >= 100.0 {
         format!("{x:.0}")
     } else {
