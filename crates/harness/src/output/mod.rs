@@ -3,6 +3,7 @@
 //! page drawn from a report.
 
 pub mod agreement;
+pub mod compare_table;
 pub mod png;
 pub mod preview;
 pub mod render;
