@@ -35,7 +35,7 @@ pub fn real_scenes() -> io::Result<Vec<PathBuf>> {
 const VIEW_PROBE_TRIANGLES: u64 = 200;
 
 /// The spec [`write_generators`] generates to learn the views of `info`: the generator at
-/// [`VIEW_PROBE_TRIANGLES`] if it has a `triangles` parameter, else at its defaults.
+/// `VIEW_PROBE_TRIANGLES` if it has a `triangles` parameter, else at its defaults.
 pub fn view_probe_spec(info: &GeneratorInfo) -> String {
     match info.params.iter().find(|p| p.key == "triangles") {
         Some(p) => {

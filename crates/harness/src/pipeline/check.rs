@@ -28,7 +28,7 @@ impl std::fmt::Debug for Sides<'_> {
     }
 }
 
-/// Classifies every ray; also returns each ray's disagreement level (see [`disagreement`]).
+/// Classifies every ray; also returns each ray's disagreement level (see `disagreement`).
 /// Any-hit disagreements are arbitrated through both sides' closest hits, computed for the
 /// disputed rays only.
 pub fn check_answers(

@@ -174,7 +174,7 @@ fn time_passes(
 }
 
 /// One closest-point pass over every point through the structure's batch path, like
-/// [`trace_pass`]: a plain loop with one thread, rayon chunks of [`CHUNK`] points otherwise.
+/// [`trace_pass`]: a plain loop with one thread, rayon chunks of `CHUNK` points otherwise.
 pub fn point_pass(
     accel: &dyn Accel,
     points: &[Vec3],

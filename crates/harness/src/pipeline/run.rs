@@ -3,7 +3,7 @@
 //!
 //! Ray workloads and closest-point workloads share the pipeline (build once, warm-up + median
 //! of timed passes, an untimed counted pass, every answer checked against the reference) but
-//! not the code that handles rays: [`SceneRun`] keeps the two kinds in separate lists.
+//! not the code that handles rays: `SceneRun` keeps the two kinds in separate lists.
 
 use super::check::{
     Sides, check_answers, check_points, counted_path_differences, counted_point_differences,

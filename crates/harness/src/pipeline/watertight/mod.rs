@@ -9,7 +9,7 @@
 //! coming in through the front of every triangle around it (|cos| ≥ 1/4 to each).
 //!
 //! Each ray is a segment: `origin + t · dir` passes through the aimed point (exact, in f64) at
-//! `t = 1` to within the rounding of the direction (see [`segment_through`]) and ends at
+//! `t = 1` to within the rounding of the direction (see `aimed::segment_through`) and ends at
 //! `t_max = 1.25`, well before the far side of the mesh, so a far-side hit cannot
 //! hide a crack at the near side. A ray is kept only when a double-precision test confirms it
 //! crosses one of the triangles around the aimed point inside the segment; every kept ray
