@@ -11,7 +11,7 @@
 //!
 //! `bvh-bin4` is the binary tree the 8-wide BVH is collapsed from (`WideParams::default()`'s
 //! `binary` knobs) built and flattened on its own: the difference to `bvh8` is the collapse and
-//! the triangle packets. The digests identify the trees (nodes and triangle order), to check
+//! the `Tri4` leaves. The digests identify the trees (nodes and triangle order), to check
 //! that a builder change keeps them identical, and with any thread count.
 //!
 //! `cargo run --release -p raybench-harness --example build_time -- ../shared/scenes/stanford-bunny.obj 2 21`

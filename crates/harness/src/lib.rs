@@ -1,22 +1,16 @@
 //! raybench-harness: runs suites of scenes × structures × workloads, times builds and traces,
-//! validates every ray against a reference, and writes `report.json`.
+//! checks every answer against a reference, and writes `report.json`.
+//!
+//! Four rooms: [`cli`] (one module per `raybench` subcommand), [`pipeline`] (the measurement
+//! machinery: workers, scenes, workloads, timing, checking, dumps), [`report`] (the schema of
+//! each report kind, reading and writing it, and the diff of two reports) and [`output`] (what
+//! is shown to people: tables, the results page, charts, pictures and the HTML page).
 #![forbid(unsafe_code)]
 
-pub mod agreement;
 pub mod atomic;
 pub mod cli;
-pub mod compare;
-pub mod dump;
 pub mod env;
-pub mod images;
-pub mod measure;
+pub mod output;
+pub mod pipeline;
 pub mod registry;
-pub mod render;
-pub mod replay;
 pub mod report;
-pub mod run;
-pub mod scene_cmd;
-pub mod summary;
-pub mod validate;
-pub mod verify;
-pub mod watertight;

@@ -141,13 +141,13 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<Bvh4>(
             "bvh4-binned",
-            "4-wide BVH collapsed from a binned SAH tree priced for SIMD 4-triangle leaves (empty slots filled by splitting leaves), 4-lane box test of 4 children, AVX2 leaves two packets a pass (AVX-512 registers when present, SSE fallback), ordered",
+            "4-wide BVH collapsed from a binned SAH tree priced for SIMD 4-triangle leaves (empty slots filled by splitting leaves), 4-lane box test of 4 children, AVX2 leaves test two Tri4s a pass (AVX-512 registers when present, SSE fallback), ordered",
             None,
             |_| WideParams::for_width(4),
         ),
         register::<Bvh8>(
             "bvh8-binned",
-            "8-wide BVH collapsed from a binned SAH tree priced for SIMD 4-triangle leaves (empty slots filled by splitting leaves), AVX2 box test of 8 children and leaves two packets a pass (AVX-512 registers when present, SSE fallback), ordered",
+            "8-wide BVH collapsed from a binned SAH tree priced for SIMD 4-triangle leaves (empty slots filled by splitting leaves), AVX2 box test of 8 children and leaves test two Tri4s a pass (AVX-512 registers when present, SSE fallback), ordered",
             None,
             |_| WideParams::for_width(8),
         ),

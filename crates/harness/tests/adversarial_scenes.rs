@@ -4,8 +4,9 @@
 
 mod common;
 
-use raybench_harness::report::Report;
-use raybench_harness::run::{RunOptions, SceneRequest, run};
+use raybench_harness::pipeline::run::{RunOptions, run};
+use raybench_harness::report::run::Report;
+use raybench_scenes::SceneRequest;
 use raybench_scenes::generators;
 
 const STRUCTURES: [&str; 6] = [
@@ -79,11 +80,11 @@ fn problems(spec: &str, report: &Report) -> Vec<String> {
     }
     for r in &report.results {
         for w in &r.workloads {
-            let v = &w.validation;
+            let v = &w.agreement;
             if v.counts.mismatch != 0 {
                 out.push(format!(
                     "{spec}: {} / {}: {} mismatches in {} rays; first: {:?}",
-                    r.structure, w.workload, v.counts.mismatch, w.rays, v.first_mismatches
+                    r.structure, w.workload, v.counts.mismatch, w.queries, v.first_mismatches
                 ));
             }
             if v.counted_path_differs != 0 {
@@ -92,19 +93,19 @@ fn problems(spec: &str, report: &Report) -> Vec<String> {
                     r.structure, w.workload, v.counted_path_differs
                 ));
             }
-            if v.rays() as usize != w.rays {
+            if v.queries() as usize != w.queries {
                 out.push(format!(
                     "{spec}: {} / {}: {} rays classified of {}",
                     r.structure,
                     w.workload,
-                    v.rays(),
-                    w.rays
+                    v.queries(),
+                    w.queries
                 ));
             }
-            if !(w.mrays_per_s.median.is_finite() && w.mrays_per_s.median >= 0.0) {
+            if !(w.mqueries_per_s.median.is_finite() && w.mqueries_per_s.median >= 0.0) {
                 out.push(format!(
                     "{spec}: {} / {}: throughput {}",
-                    r.structure, w.workload, w.mrays_per_s.median
+                    r.structure, w.workload, w.mqueries_per_s.median
                 ));
             }
         }
@@ -120,7 +121,7 @@ fn check_all(specs: &[&str]) {
             let summary: Vec<String> = r
                 .workloads
                 .iter()
-                .map(|w| format!("{} {:?}", w.workload, w.validation.counts))
+                .map(|w| format!("{} {:?}", w.workload, w.agreement.counts))
                 .collect();
             eprintln!("{spec} {}: {}", r.structure, summary.join("; "));
         }
@@ -163,7 +164,7 @@ fn empty_scene_builds_everywhere_and_every_ray_misses() {
             .workloads
             .iter()
             .find(|w| w.workload == name)
-            .map(|w| w.rays)
+            .map(|w| w.queries)
     };
     assert!(rays_of("primary").unwrap() > 0 && rays_of("random") == Some(2_000));
     assert_eq!((rays_of("shadow"), rays_of("diffuse")), (Some(0), Some(0)));
@@ -171,10 +172,10 @@ fn empty_scene_builds_everywhere_and_every_ray_misses() {
         let names: Vec<&str> = r.workloads.iter().map(|w| w.workload.as_str()).collect();
         assert_eq!(names, ["primary", "random"], "{}", r.structure);
         for w in &r.workloads {
-            let c = &w.validation.counts;
+            let c = &w.agreement.counts;
             assert_eq!(c.mismatch, 0, "{} / {}", r.structure, w.workload);
             assert_eq!(
-                c.both_miss, w.rays as u64,
+                c.both_miss, w.queries as u64,
                 "{} / {}: every ray misses ({c:?})",
                 r.structure, w.workload
             );

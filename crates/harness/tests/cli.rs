@@ -106,14 +106,14 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
         "{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let report = raybench_harness::report::Report::read(&dir.join("report.json")).unwrap();
+    let report = raybench_harness::report::run::Report::read(&dir.join("report.json")).unwrap();
     assert_eq!(report.mismatches(), 0);
     assert!(report.errors.is_empty(), "{:?}", report.errors);
     let points_near = report
         .results
         .iter()
         .flat_map(|r| &r.workloads)
-        .filter(|w| w.workload == "points-near" && w.point_query && w.rays == 300)
+        .filter(|w| w.workload == "points-near" && w.point_query && w.queries == 300)
         .count();
     assert!(
         points_near >= 9 * 14,
@@ -319,16 +319,16 @@ fn point_workloads_run_from_the_command_line_and_unknown_ones_are_refused() {
     assert_eq!(code, 0, "{stdout}\n{stderr}");
     assert!(stdout.contains("points-near Mq/s"), "{stdout}");
     assert!(stdout.contains("Closest-point work per query"), "{stdout}");
-    let report = raybench_harness::report::Report::read(&dir.join("report.json")).unwrap();
+    let report = raybench_harness::report::run::Report::read(&dir.join("report.json")).unwrap();
     assert_eq!(report.run.workloads, ["points-near"]);
     assert_eq!(report.run.points, 250);
     for r in &report.results {
         let w = &r.workloads[..];
         assert!(
-            w.len() == 1 && w[0].point_query && w[0].rays == 250,
+            w.len() == 1 && w[0].point_query && w[0].queries == 250,
             "{w:?}"
         );
-        assert_eq!(w[0].validation.counts.mismatch, 0);
+        assert_eq!(w[0].agreement.counts.mismatch, 0);
     }
     std::fs::remove_dir_all(dir).unwrap();
     for command in ["run", "verify"] {
@@ -433,7 +433,7 @@ fn a_scene_failing_midway_still_leaves_a_whole_report_and_no_temporary_file() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(code, 1, "{stdout}{stderr}");
-    let report = raybench_harness::report::Report::read(&out.join("report.json")).unwrap();
+    let report = raybench_harness::report::run::Report::read(&out.join("report.json")).unwrap();
     assert_eq!(report.errors.len(), 1, "{:?}", report.errors);
     assert!(
         report.errors[0].contains("broken.obj"),
@@ -474,13 +474,14 @@ fn verify_passes_on_a_small_scene_and_writes_verify_json_and_dumps() {
     ] {
         assert!(stdout.contains(expected), "{expected}: {stdout}");
     }
-    let report = raybench_harness::verify::VerifyReport::read(&dir.join("verify.json")).unwrap();
+    let report =
+        raybench_harness::report::verify::VerifyReport::read(&dir.join("verify.json")).unwrap();
     assert_eq!(
         report.totals.len(),
         2 * 3,
         "two structures × three references"
     );
-    let index = raybench_harness::dump::read_index(&dir.join("hits")).unwrap();
+    let index = raybench_harness::pipeline::dump::read_index(&dir.join("hits")).unwrap();
     assert_eq!(index.files.len(), 2 * 5, "two structures × five workloads");
     assert!(files_below(&dir).iter().all(|f| !f.contains(".tmp")));
     std::fs::remove_dir_all(dir).unwrap();

@@ -3,9 +3,11 @@
 
 mod common;
 
-use raybench_harness::compare::{CompareOptions, Severity, compare};
-use raybench_harness::report::Report;
-use raybench_harness::run::{SceneRequest, run};
+use raybench_harness::pipeline::run::run;
+use raybench_harness::report::compare::{CompareOptions, Severity, compare};
+use raybench_harness::report::run::Report;
+use raybench_scenes::SceneRequest;
+use std::path::Path;
 use std::process::Command;
 use std::sync::OnceLock;
 
@@ -14,7 +16,7 @@ fn base() -> &'static Report {
     static REPORT: OnceLock<Report> = OnceLock::new();
     REPORT.get_or_init(|| {
         let opts = raybench_scenes::Workload::ALL[..2].to_vec();
-        let options = raybench_harness::run::RunOptions {
+        let options = raybench_harness::pipeline::run::RunOptions {
             workloads: opts,
             rays: 1000,
             ..common::options(&["bruteforce", "bvh-binned", "embree-medium"])
@@ -32,7 +34,7 @@ fn regressions(new: &Report, opts: &CompareOptions) -> Vec<String> {
         .collect()
 }
 
-fn bvh(report: &mut Report) -> &mut raybench_harness::report::ResultEntry {
+fn bvh(report: &mut Report) -> &mut raybench_harness::report::run::ResultEntry {
     report
         .results
         .iter_mut()
@@ -73,7 +75,7 @@ fn a_changed_sah_cost_is_a_regression() {
 #[test]
 fn a_new_mismatch_is_a_regression() {
     let mut new = base().clone();
-    bvh(&mut new).workloads[1].validation.counts.mismatch += 1;
+    bvh(&mut new).workloads[1].agreement.counts.mismatch += 1;
     let r = regressions(&new, &CompareOptions::default());
     assert!(
         r.iter().any(|x| x.contains("mismatches rose from 0 to 1")),
@@ -119,7 +121,7 @@ fn a_missing_structure_is_a_regression() {
 fn different_settings_and_machines_are_flagged() {
     let mut new = base().clone();
     new.run.seed += 1;
-    new.environment.cpu_model = "Another CPU".into();
+    new.header.environment.cpu_model = "Another CPU".into();
     let c = compare(base(), &new, &CompareOptions::default());
     assert!(
         c.markdown.contains("WARNING: different environments (CPU"),
@@ -176,5 +178,61 @@ fn the_command_exits_0_on_identical_reports_and_2_on_a_regression() {
         .unwrap();
     assert_eq!(missing.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("/nonexistent/base.json"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A report of schema version 1 (fields named after rays) reads through the old names into the
+/// same report, and compares against a new one without a regression.
+#[test]
+fn a_schema_1_report_reads_through_the_old_names() {
+    let mut old = serde_json::to_value(base()).unwrap();
+    old["schema_version"] = 1.into();
+    let renames = [
+        ("queries", "rays"),
+        ("mqueries_per_s", "mrays_per_s"),
+        ("counters_per_query", "counters_per_ray"),
+        ("agreement", "validation"),
+    ];
+    let rename = |object: &mut serde_json::Value| {
+        let map = object.as_object_mut().unwrap();
+        for (new, was) in renames {
+            if let Some(v) = map.remove(new) {
+                map.insert(was.to_string(), v);
+            }
+        }
+    };
+    for scene in old["scenes"].as_array_mut().unwrap() {
+        scene["workloads"]
+            .as_array_mut()
+            .unwrap()
+            .iter_mut()
+            .for_each(rename);
+    }
+    for result in old["results"].as_array_mut().unwrap() {
+        result["workloads"]
+            .as_array_mut()
+            .unwrap()
+            .iter_mut()
+            .for_each(rename);
+    }
+    let dir = std::env::temp_dir().join(format!("raybench-schema-1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("report.json");
+    std::fs::write(&path, serde_json::to_vec_pretty(&old).unwrap()).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("\"mrays_per_s\"") && !text.contains("\"mqueries_per_s\""));
+    let read = Report::read(&path).expect("a schema-1 report reads");
+    assert_eq!(read.header.schema_version, 1);
+    let mut same = read.clone();
+    same.header.schema_version = base().header.schema_version;
+    assert_eq!(
+        serde_json::to_string(&same).unwrap(),
+        serde_json::to_string(base()).unwrap()
+    );
+    let c = compare(&read, base(), &CompareOptions::default());
+    assert_eq!(c.regressions(), 0, "{}", c.markdown);
+    // The baseline CI compares against loads whatever version it was written with.
+    let baseline = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/baseline/ci.json");
+    Report::read(&baseline).expect("reports/baseline/ci.json reads");
     std::fs::remove_dir_all(&dir).ok();
 }

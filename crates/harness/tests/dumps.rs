@@ -4,10 +4,11 @@
 
 mod common;
 
-use raybench_harness::dump::{read_dump, read_index};
+use raybench_harness::pipeline::dump::{read_dump, read_index};
+use raybench_harness::pipeline::run::{RunOptions, run};
 use raybench_harness::registry::{self, BuildContext};
-use raybench_harness::report::Report;
-use raybench_harness::run::{RunOptions, SceneRequest, run};
+use raybench_harness::report::run::Report;
+use raybench_scenes::SceneRequest;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -64,7 +65,7 @@ fn a_dump_matches_the_report_and_a_re_trace() {
         let dump = read_dump(&dir.join(&e.file)).unwrap();
         assert_eq!(
             (dump.records.len(), dump.any_hit),
-            (w.rays, w.any_hit),
+            (w.queries, w.any_hit),
             "{}",
             e.file
         );

@@ -2,12 +2,13 @@
 
 mod common;
 
-use raybench_harness::compare::{CompareOptions, Severity, compare};
-use raybench_harness::measure::point_pass;
+use raybench_harness::pipeline::check::check_points;
+use raybench_harness::pipeline::measure::point_pass;
+use raybench_harness::pipeline::run::{RunOptions, run};
 use raybench_harness::registry::{self, BuildContext};
-use raybench_harness::report::{Report, WorkloadResult};
-use raybench_harness::run::{RunOptions, SceneRequest, run};
-use raybench_harness::validate::validate_points;
+use raybench_harness::report::compare::{CompareOptions, Severity, compare};
+use raybench_harness::report::run::{Report, WorkloadResult};
+use raybench_scenes::SceneRequest;
 use raybench_scenes::Workload;
 use raybench_scenes::points::PointWorkload;
 
@@ -57,11 +58,11 @@ fn point_workloads_agree_with_embree_count_work_and_do_not_depend_on_threads() {
     let results = point_results(&one);
     assert_eq!(results.len(), SCENES.len() * STRUCTURES.len() * 2);
     for (scene, structure, w) in &results {
-        let v = &w.validation;
+        let v = &w.agreement;
         let label = format!("{structure} on {scene} / {}", w.workload);
         assert!(w.point_query && !w.any_hit, "{label}");
-        assert_eq!(w.rays, 400, "{label}");
-        assert_eq!(v.rays(), 400, "{label}: every query classified");
+        assert_eq!(w.queries, 400, "{label}");
+        assert_eq!(v.queries(), 400, "{label}: every query classified");
         assert_eq!(
             v.counts.mismatch, 0,
             "{label}: {:?}",
@@ -72,12 +73,12 @@ fn point_workloads_agree_with_embree_count_work_and_do_not_depend_on_threads() {
             v.counts.both_miss, 0,
             "{label}: infinite radius, always an answer"
         );
-        assert!(w.mrays_per_s.median > 0.0, "{label}");
+        assert!(w.mqueries_per_s.median > 0.0, "{label}");
         assert!(
             w.speedup_vs_reference.is_some(),
             "{label}: a ratio to embree-medium"
         );
-        match (structure.starts_with("embree"), &w.counters_per_ray) {
+        match (structure.starts_with("embree"), &w.counters_per_query) {
             (true, c) => assert!(c.is_none(), "{label}: Embree cannot count"),
             (false, Some(c)) => assert!(c.prim_tests >= 1.0, "{label}: {c:?}"),
             (false, None) => panic!("{label}: no counters"),
@@ -88,7 +89,7 @@ fn point_workloads_agree_with_embree_count_work_and_do_not_depend_on_threads() {
         results
             .iter()
             .find(|(s, st, w)| *s == SCENES[0] && *st == structure && w.workload == "points-near")
-            .and_then(|(_, _, w)| w.counters_per_ray)
+            .and_then(|(_, _, w)| w.counters_per_query)
             .map(|c| c.prim_tests)
             .unwrap()
     };
@@ -109,7 +110,7 @@ fn point_workloads_agree_with_embree_count_work_and_do_not_depend_on_threads() {
             a.counters_total, b.counters_total,
             "{st1} on {s1}: counters"
         );
-        assert_eq!(a.validation.counts, b.validation.counts, "{st1} on {s1}");
+        assert_eq!(a.agreement.counts, b.agreement.counts, "{st1} on {s1}");
     }
 }
 
@@ -150,7 +151,7 @@ fn batch_answers_are_identical_on_one_and_two_threads_and_a_wrong_answer_is_a_mi
         .iter()
         .map(|&p| embree.closest_point(p, f32::INFINITY))
         .collect();
-    let fine = validate_points(
+    let fine = check_points(
         &mesh,
         &points,
         f32::INFINITY,
@@ -165,7 +166,7 @@ fn batch_answers_are_identical_on_one_and_two_threads_and_a_wrong_answer_is_a_mi
     hit.prim = (hit.prim + 1000) % mesh.len() as u32;
     hit.distance *= 1.5;
     wrong[5] = Some(hit);
-    let bad = validate_points(
+    let bad = check_points(
         &mesh,
         &points,
         f32::INFINITY,

@@ -4,9 +4,10 @@
 
 mod common;
 
-use raybench_harness::render::{pictures, render};
-use raybench_harness::report::Report;
-use raybench_harness::run::{SceneRequest, run};
+use raybench_harness::output::render::{pictures, render};
+use raybench_harness::pipeline::run::run;
+use raybench_harness::report::run::Report;
+use raybench_scenes::SceneRequest;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -15,7 +16,7 @@ use std::sync::OnceLock;
 fn report() -> &'static Report {
     static REPORT: OnceLock<Report> = OnceLock::new();
     REPORT.get_or_init(|| {
-        let options = raybench_harness::run::RunOptions {
+        let options = raybench_harness::pipeline::run::RunOptions {
             workloads: raybench_scenes::Workload::ALL[..2].to_vec(),
             rays: 2000,
             ..common::options(&["bruteforce", "bvh-binned", "embree-medium"])

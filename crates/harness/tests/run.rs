@@ -1,11 +1,12 @@
 //! End-to-end: `run` on small procedural scenes against Embree, the report round-trip, and
 //! determinism of rays and counters.
 
-use raybench_harness::report::Report;
+use raybench_harness::report::run::Report;
 mod common;
 
 use common::options;
-use raybench_harness::run::{SceneRequest, run};
+use raybench_harness::pipeline::run::run;
+use raybench_scenes::SceneRequest;
 use raybench_scenes::Workload;
 use std::path::PathBuf;
 
@@ -47,7 +48,7 @@ fn bruteforce_and_every_embree_variant_agree() {
             r.scene
         );
         for w in &r.workloads {
-            let v = &w.validation;
+            let v = &w.agreement;
             assert_eq!(
                 v.counts.mismatch, 0,
                 "{} on {} / {}: {:?}",
@@ -58,23 +59,23 @@ fn bruteforce_and_every_embree_variant_agree() {
                 "{} {} {}",
                 r.structure, r.scene, w.workload
             );
-            assert_eq!(v.rays() as usize, w.rays);
-            assert!(w.mrays_per_s.median > 0.0 && w.mrays_per_s.median.is_finite());
+            assert_eq!(v.queries() as usize, w.queries);
+            assert!(w.mqueries_per_s.median > 0.0 && w.mqueries_per_s.median.is_finite());
             assert_eq!(
-                w.counters_per_ray.is_some(),
+                w.counters_per_query.is_some(),
                 r.structure.starts_with("bruteforce")
             );
             if r.structure == "embree-medium" {
                 assert_eq!(
                     v.counts.exact + v.counts.both_miss,
-                    w.rays as u64,
+                    w.queries as u64,
                     "the reference agrees with itself exactly"
                 );
             }
         }
         // Every primary ray hits the sphere's default view somewhere or misses cleanly; the
         // workloads must have produced rays.
-        assert!(r.workloads.iter().all(|w| w.rays > 0));
+        assert!(r.workloads.iter().all(|w| w.queries > 0));
     }
     // Ratios exist for everything and are exactly 1 for the reference.
     let reference = report
@@ -116,8 +117,8 @@ fn report_round_trips_through_serde_and_is_written_atomically() {
         "schema_version",
         "environment",
         "git_revision",
-        "mrays_per_s",
-        "counters_per_ray",
+        "mqueries_per_s",
+        "counters_per_query",
         "first_mismatches",
     ] {
         assert!(text.contains(field), "report lacks {field}");
@@ -144,9 +145,9 @@ fn same_seed_gives_identical_rays_and_counters() {
                         e.scene,
                         e.structure,
                         w.workload,
-                        w.rays,
+                        w.queries,
                         w.counters_total,
-                        w.validation.counts
+                        w.agreement.counts
                     )
                 })
             })

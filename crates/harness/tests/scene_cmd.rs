@@ -1,7 +1,7 @@
 //! `raybench scene list | export | preview`, as a user runs them, and the preview renderer.
 
 use raybench_geom::TriangleMesh;
-use raybench_harness::scene_cmd::{background, render_preview};
+use raybench_harness::output::preview::{background, render_preview};
 use raybench_scenes::{Scene, Vec3, View};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -4,13 +4,14 @@
 
 use raybench_accel::Hit;
 use raybench_geom::{Ray, Vec3};
-use raybench_harness::dump::{read_dump, read_index};
-use raybench_harness::report::DisputedRay;
-use raybench_harness::run::SceneRequest;
-use raybench_harness::verify::{
-    REFERENCES, VerifyOptions, VerifyReport, brute_force_sample, verify, verify_table,
-};
-use raybench_harness::watertight::{Case, EMBREE_POSITION, WatertightOptions, watertight};
+use raybench_harness::output::verify_table::verify_table;
+use raybench_harness::pipeline::dump::{read_dump, read_index};
+use raybench_harness::pipeline::verify::{REFERENCES, VerifyOptions, brute_force_sample, verify};
+use raybench_harness::pipeline::watertight::{EMBREE_POSITION, WatertightOptions, watertight};
+use raybench_harness::report::agreement::DisputedRay;
+use raybench_harness::report::verify::VerifyReport;
+use raybench_harness::report::watertight::Case;
+use raybench_scenes::SceneRequest;
 use raybench_scenes::Workload;
 use std::path::PathBuf;
 use std::sync::OnceLock;
@@ -59,9 +60,9 @@ fn every_structure_is_checked_against_three_references_with_zero_mismatches() {
     let mut subsampled = 0;
     for scene in &r.scenes {
         for w in &scene.workloads {
-            let want = brute_force_sample(w.rays, scene.triangles.traced as usize, BUDGET).len();
-            assert_eq!(w.brute_force_rays, want);
-            subsampled += usize::from(want < w.rays);
+            let want = brute_force_sample(w.queries, scene.triangles.traced as usize, BUDGET).len();
+            assert_eq!(w.brute_force_queries, want);
+            subsampled += usize::from(want < w.queries);
         }
     }
     assert!(
@@ -77,17 +78,17 @@ fn every_structure_is_checked_against_three_references_with_zero_mismatches() {
             .find(|w| w.workload == res.workload)
             .unwrap();
         let refs: Vec<&str> = res
-            .validations
+            .agreements
             .iter()
             .map(|v| v.reference.as_str())
             .collect();
         assert_eq!(refs, REFERENCES);
-        let checked: Vec<u64> = res.validations.iter().map(|v| v.rays()).collect();
-        let (all, sample) = (w.rays as u64, w.brute_force_rays as u64);
+        let checked: Vec<u64> = res.agreements.iter().map(|v| v.queries()).collect();
+        let (all, sample) = (w.queries as u64, w.brute_force_queries as u64);
         let exhaustive = res.structure.starts_with("bruteforce");
         let traced = if exhaustive { sample } else { all };
         assert_eq!(
-            res.rays as u64, traced,
+            res.queries as u64, traced,
             "{} {}",
             res.structure, res.workload
         );
@@ -99,7 +100,7 @@ fn every_structure_is_checked_against_three_references_with_zero_mismatches() {
         };
         assert_eq!(checked, want, "{} {}", res.structure, res.workload);
         if res.structure == "embree-medium" {
-            let c = &res.validations[0].counts;
+            let c = &res.agreements[0].counts;
             assert_eq!(
                 c.exact + c.both_miss,
                 all,
@@ -109,7 +110,10 @@ fn every_structure_is_checked_against_three_references_with_zero_mismatches() {
     }
     assert_eq!(r.totals.len(), n * 3);
     for row in &r.totals {
-        let want = format!("0 mismatches in {} rays (95% upper bound 3/n = ", row.rays);
+        let want = format!(
+            "0 mismatches in {} rays (95% upper bound 3/n = ",
+            row.queries
+        );
         assert!(row.agreement.starts_with(&want), "{}", row.agreement);
     }
     let table = verify_table(r);
@@ -136,7 +140,7 @@ fn dumps_hold_every_traced_ray_with_its_workload_index() {
             .find(|x| x.scene == e.scene && x.structure == e.structure && x.workload == e.workload)
             .unwrap();
         let dump = read_dump(&dir.join(&e.file)).unwrap();
-        assert_eq!(dump.records.len(), res.rays, "{}", e.file);
+        assert_eq!(dump.records.len(), res.queries, "{}", e.file);
         assert_eq!(dump.any_hit, res.any_hit);
         let indices: Vec<usize> = dump.records.iter().map(|x| x.ray_index as usize).collect();
         let scene = r.scenes.iter().find(|s| s.name == e.scene).unwrap();
@@ -146,9 +150,9 @@ fn dumps_hold_every_traced_ray_with_its_workload_index() {
             .find(|w| w.workload == e.workload)
             .unwrap();
         let want = if res.subsampled {
-            brute_force_sample(w.rays, scene.triangles.traced as usize, BUDGET)
+            brute_force_sample(w.queries, scene.triangles.traced as usize, BUDGET)
         } else {
-            (0..w.rays).collect()
+            (0..w.queries).collect()
         };
         assert_eq!(indices, want, "{}", e.file);
     }
@@ -172,7 +176,7 @@ fn a_mismatch_prints_a_replay_command_that_replays() {
         .iter_mut()
         .find(|x| x.structure == "grid" && x.scene == SCENES[0])
         .unwrap();
-    let v = &mut res.validations[1];
+    let v = &mut res.agreements[1];
     v.counts.mismatch += 1;
     v.first_mismatches
         .push(DisputedRay::new(7, "mismatch", &ray, Some(hit), None));
@@ -253,4 +257,58 @@ fn far_from_the_origin_watertight_tests_find_no_crack_and_moller_does() {
     assert_eq!(misses("bruteforce-watertight").misses, 0);
     assert_eq!(misses("embree-robust").misses, 0);
     assert!(misses("bruteforce").misses > 0, "{:?}", r.results);
+}
+
+/// A verify.json of schema version 1 (fields named after rays, `validations`) reads through the
+/// old names into the same report.
+#[test]
+fn a_schema_1_verify_json_reads_through_the_old_names() {
+    let mut old = serde_json::to_value(report()).unwrap();
+    old["schema_version"] = 1.into();
+    let rename = |object: &mut serde_json::Value| {
+        let map = object.as_object_mut().unwrap();
+        for (new, was) in [
+            ("queries", "rays"),
+            ("brute_force_queries", "brute_force_rays"),
+            ("agreements", "validations"),
+        ] {
+            if let Some(v) = map.remove(new) {
+                map.insert(was.to_string(), v);
+            }
+        }
+    };
+    for scene in old["scenes"].as_array_mut().unwrap() {
+        scene["workloads"]
+            .as_array_mut()
+            .unwrap()
+            .iter_mut()
+            .for_each(rename);
+    }
+    old["results"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .for_each(rename);
+    old["totals"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .for_each(rename);
+    let dir = std::env::temp_dir().join(format!("raybench-verify-v1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("verify.json");
+    std::fs::write(&path, serde_json::to_vec_pretty(&old).unwrap()).unwrap();
+    assert!(
+        std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("\"validations\"")
+    );
+    let mut read = VerifyReport::read(&path).expect("a schema-1 verify.json reads");
+    assert_eq!(read.header.schema_version, 1);
+    read.header.schema_version = report().header.schema_version;
+    assert_eq!(
+        serde_json::to_string(&read).unwrap(),
+        serde_json::to_string(report()).unwrap()
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -1,7 +1,7 @@
 //! Shared by the harness's integration tests.
 #![allow(dead_code)]
 
-use raybench_harness::run::RunOptions;
+use raybench_harness::pipeline::run::RunOptions;
 use raybench_scenes::Workload;
 
 /// A quick, explicit run: every ray workload, 3000 rays (500 points if a test adds a point workload), one thread, one build and one trace pass,
@@ -9,7 +9,6 @@ use raybench_scenes::Workload;
 pub fn options(structures: &[&str]) -> RunOptions {
     RunOptions {
         suite: None,
-        scenes: vec![],
         structures: structures.iter().map(|s| s.to_string()).collect(),
         workloads: Workload::RAYS.to_vec(),
         rays: 3000,

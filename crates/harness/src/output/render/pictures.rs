@@ -2,8 +2,8 @@
 //! scene, shaded renders, and "disagrees with the reference" masks. No text is drawn into the
 //! PNGs (that would need fonts); the HTML page labels them and the legend's numbers.
 
-use crate::images::PrimaryImage;
-use crate::scene_cmd::write_png;
+use crate::output::png::write_png;
+use crate::pipeline::images::PrimaryImage;
 use anyhow::{Result, anyhow};
 use std::path::Path;
 

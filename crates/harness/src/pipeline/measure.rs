@@ -7,15 +7,15 @@
 //! counting passes are separate, untimed, single-threaded walks.
 
 use crate::registry::{BuildContext, Built, StructureEntry};
-use crate::report::{Throughput, Timing};
+use crate::report::run::{Throughput, Timing};
 use raybench_accel::{Accel, BuildError, Counters, Hit, PointHit, PreparedRays};
 use raybench_geom::{Ray, TriangleMesh, Vec3};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Rays (or query points) per rayon task when tracing with several threads: large enough that scheduling costs
-/// are noise (~1 µs per task vs ≥ 25 µs of tracing), small enough to balance 2 cores.
+/// Queries per rayon task when tracing with several threads: large enough that scheduling
+/// costs are noise (~1 µs per task vs ≥ 25 µs of tracing), small enough to balance 2 cores.
 const CHUNK: usize = 256;
 
 /// A warm-up pass longer than this is measured once more, not `trace_runs` times, so a brute
@@ -134,7 +134,7 @@ pub fn trace_pass(
     start.elapsed()
 }
 
-/// A warm-up pass (whose answers are returned for validation), then timed passes.
+/// A warm-up pass (whose answers are returned to be checked), then timed passes.
 pub fn time_traces(
     accel: &dyn Accel,
     rays: &[Ray],
@@ -174,7 +174,7 @@ fn time_passes(
 }
 
 /// One closest-point pass over every point through the structure's batch path, like
-/// [`trace_pass`]: a plain loop with one thread, rayon chunks of [`CHUNK`] points otherwise.
+/// [`trace_pass`]: a plain loop with one thread, rayon chunks of `CHUNK` points otherwise.
 pub fn point_pass(
     accel: &dyn Accel,
     points: &[Vec3],
@@ -193,7 +193,7 @@ pub fn point_pass(
     start.elapsed()
 }
 
-/// A warm-up closest-point pass (whose answers are returned for validation), then timed
+/// A warm-up closest-point pass (whose answers are returned to be checked), then timed
 /// passes: the method of [`time_traces`]. Throughput is in millions of queries per second.
 pub fn time_point_queries(
     accel: &dyn Accel,
@@ -226,7 +226,6 @@ pub fn count_point_pass(
     (answers, c)
 }
 
-/// The untimed counting walk, single-threaded so the counters are deterministic.
 /// The counted walk over every ray, single-threaded (counters are exact, not timed). Also
 /// returns each ray's work (interior nodes + leaves + triangle tests + cells), for the
 /// traversal-cost images.

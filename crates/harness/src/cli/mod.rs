@@ -1,14 +1,24 @@
-//! The command-line pieces `run` and `verify` share (which scenes, structures, workloads and
-//! rays; checks of every value before any work starts), and the `verify`, `replay` and
-//! `watertight` subcommands. Every bad value is one error line naming it, exit status 1.
+//! The subcommands of `raybench`, one module each (its clap arguments and its handler), and
+//! what several of them share: which scenes, structures, workloads and rays (the [`Selection`]
+//! flags and their resolution), checks of every value and output directory before any work
+//! starts, and the exit status. Every bad value is one error line naming it, exit status 1.
+
+pub mod compare;
+pub mod list;
+pub mod replay;
+pub mod report;
+pub mod results;
+pub mod run;
+pub mod scene;
+pub mod verify;
+pub mod watertight;
 
 use crate::atomic::ensure_writable_dir;
+use crate::pipeline::scenes::check_requests;
 use crate::registry;
-use crate::run::{SceneRequest, check_requests};
 use anyhow::{Context, Result};
 use clap::Args;
-use raybench_scenes::Workload;
-use std::io::IsTerminal;
+use raybench_scenes::{SceneRequest, Workload};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -19,7 +29,7 @@ pub const DEFAULT_POINTS: usize = 10_000;
 
 /// A count that must be at least 1: `--rays 0` or `--threads abc` is refused by clap as
 /// "invalid value '0' for '--rays <RAYS>': must be a whole number of at least 1".
-fn at_least_one(text: &str) -> Result<usize, String> {
+pub(crate) fn at_least_one(text: &str) -> Result<usize, String> {
     match text.trim().parse::<usize>() {
         Ok(n) if n >= 1 => Ok(n),
         _ => Err("must be a whole number of at least 1".to_string()),
@@ -27,7 +37,7 @@ fn at_least_one(text: &str) -> Result<usize, String> {
 }
 
 /// A budget of ray–triangle tests, at least 1.
-fn budget(text: &str) -> Result<u64, String> {
+pub(crate) fn budget(text: &str) -> Result<u64, String> {
     match text.trim().parse::<f64>() {
         Ok(x) if x >= 1.0 && x <= u64::MAX as f64 && x.fract() == 0.0 => Ok(x as u64),
         _ => Err("must be a whole number of at least 1 (e.g. 200000000 or 2e8)".to_string()),
@@ -195,59 +205,6 @@ pub fn default_out_dir() -> PathBuf {
     PathBuf::from("reports").join(format!("{date}-{rev}"))
 }
 
-#[derive(Args, Debug)]
-pub struct VerifyArgs {
-    #[command(flatten)]
-    pub selection: Selection,
-    /// Output directory for verify.json (default: reports/<date>-<revision>).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Write every ray and each structure's answer here (see README, "Hit dumps").
-    #[arg(long)]
-    pub dump_hits: Option<PathBuf>,
-    /// Ray–triangle tests brute force may spend per scene × workload (it checks an evenly
-    /// spaced subsample when a workload would cost more).
-    #[arg(long, default_value_t = crate::verify::BRUTE_FORCE_BUDGET, value_parser = budget)]
-    pub brute_force_budget: u64,
-}
-
-/// `raybench verify`: exit 0 with no mismatch, 2 on any mismatch (or counted-path
-/// difference), 1 on errors.
-pub fn verify_command(args: VerifyArgs) -> Result<ExitCode> {
-    use crate::verify::{VerifyOptions, verify, verify_table};
-    // Verify checks every registered structure unless told otherwise: a suite's structure list
-    // says what is worth timing, not what may go unchecked.
-    let defaults = Defaults {
-        structures: all_structures(),
-        rays: 10_000,
-        points: DEFAULT_POINTS,
-    };
-    let r = args.selection.resolve(false, defaults)?;
-    let dir = args.out.unwrap_or_else(default_out_dir);
-    check_outputs(&dir, args.dump_hits.as_deref())?;
-    let opts = VerifyOptions {
-        suite: args.selection.suite.clone(),
-        structures: r.structures,
-        workloads: r.workloads,
-        rays: r.rays,
-        points: r.points,
-        threads: args.selection.threads,
-        seed: args.selection.seed,
-        ftz_daz: args.selection.ftz_daz,
-        progress: std::io::stdout().is_terminal(),
-        brute_force_budget: args.brute_force_budget,
-        dump_hits: args.dump_hits.clone(),
-    };
-    let report = verify(&opts, &r.requests)?;
-    let path = report.write_atomic(&dir)?;
-    print!("{}", verify_table(&report));
-    println!("verify: {}", path.display());
-    if let Some(d) = &args.dump_hits {
-        println!("hit dumps: {}", d.display());
-    }
-    Ok(exit_status(report.mismatches(), report.errors.len()))
-}
-
 /// Proves both output directories writable (creating them) before any work, the dump directory
 /// first so that a bad `--dump-hits` leaves not even an empty `--out` behind.
 pub fn check_outputs(out: &Path, dump_hits: Option<&Path>) -> Result<()> {
@@ -266,78 +223,6 @@ pub fn exit_status(mismatches: u64, errors: usize) -> ExitCode {
     } else {
         ExitCode::SUCCESS
     }
-}
-
-#[derive(Args, Debug)]
-pub struct ReplayArgs {
-    /// The scene: a generator spec or an .obj path, as printed by `verify`.
-    #[arg(long)]
-    pub scene: String,
-    /// Structures to trace, comma-separated (default: every registered one); the references
-    /// embree-medium, embree-robust and bruteforce are always shown.
-    #[arg(long, value_delimiter = ',')]
-    pub structure: Vec<String>,
-    /// The ray: 8 hex f32 bit patterns ox,oy,oz,dx,dy,dz,tmin,tmax (with or without 0x,
-    /// separated by commas or spaces), as in a report's `ray_bits`.
-    #[arg(long, num_args = 1..=8, required = true)]
-    pub ray: Vec<String>,
-    /// The seed the scene was generated with.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-}
-
-pub fn replay_command(args: ReplayArgs) -> Result<ExitCode> {
-    let ray = crate::replay::parse_ray_bits(&args.ray.join(","))?;
-    registry::select(&args.structure)?;
-    if !args.scene.to_ascii_lowercase().ends_with(".obj") {
-        raybench_scenes::check_spec(&args.scene)
-            .with_context(|| format!("scene '{}'", args.scene))?;
-    }
-    let replay = crate::replay::replay(&args.scene, &args.structure, ray, args.seed)?;
-    print!("{}", replay.text());
-    Ok(ExitCode::SUCCESS)
-}
-
-#[derive(Args, Debug)]
-pub struct WatertightArgs {
-    /// Structures, comma-separated (default: every registered one).
-    #[arg(long, value_delimiter = ',')]
-    pub structures: Vec<String>,
-    /// Rays generated per case.
-    #[arg(long, default_value_t = 100_000, value_parser = at_least_one)]
-    pub rays: usize,
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Worker threads for builds and traces.
-    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
-    pub threads: usize,
-    /// Output directory for watertight.json (default: reports/<date>-<revision>).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Ray–triangle tests brute force may spend per case (it traces an evenly spaced subsample).
-    #[arg(long, default_value_t = crate::verify::BRUTE_FORCE_BUDGET, value_parser = budget)]
-    pub brute_force_budget: u64,
-}
-
-pub fn watertight_command(args: WatertightArgs) -> Result<ExitCode> {
-    use crate::watertight::{WatertightOptions, default_cases, watertight, watertight_table};
-    let structures = pick(args.structures, None, all_structures);
-    registry::select(&structures)?;
-    let dir = args.out.unwrap_or_else(default_out_dir);
-    ensure_writable_dir(&dir).context("--out")?;
-    let opts = WatertightOptions {
-        cases: default_cases(),
-        structures,
-        rays: args.rays,
-        seed: args.seed,
-        threads: args.threads,
-        brute_force_budget: args.brute_force_budget,
-    };
-    let report = watertight(&opts)?;
-    let path = report.write_atomic(&dir)?;
-    print!("{}", watertight_table(&report));
-    println!("watertight: {}", path.display());
-    Ok(exit_status(0, report.errors.len()))
 }
 
 #[cfg(test)]

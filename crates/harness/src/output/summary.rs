@@ -1,8 +1,8 @@
 //! The table printed at the end of a run: build time, throughput and agreement per scene ×
 //! structure, each with its ratio to the reference measured in the same run.
 
-use crate::agreement::{agreement_sentence_of, class_counts};
-use crate::report::{Report, is_point_workload};
+use super::agreement::{agreement_sentence_of, class_counts};
+use crate::report::run::{Report, is_point_workload};
 use raybench_accel::classify::VerdictCounts;
 use std::fmt::Write;
 
@@ -12,7 +12,7 @@ fn ratio(r: Option<f64>) -> String {
 }
 
 /// Three significant digits however small the value (brute force runs at 1e-3 Mrays/s).
-fn sig(x: f64) -> String {
+pub(crate) fn sig(x: f64) -> String {
     if x == 0.0 || x.abs() >= 100.0 {
         format!("{x:.0}")
     } else {
@@ -58,7 +58,7 @@ pub fn summary_table(report: &Report) -> String {
                     let _ = write!(
                         out,
                         " {:>10} {:>7}",
-                        sig(x.mrays_per_s.median),
+                        sig(x.mqueries_per_s.median),
                         ratio(x.speedup_vs_reference)
                     );
                 }
@@ -70,12 +70,12 @@ pub fn summary_table(report: &Report) -> String {
         let ambiguous: u64 = r
             .workloads
             .iter()
-            .map(|w| w.validation.counts.ambiguous())
+            .map(|w| w.agreement.counts.ambiguous())
             .sum();
         let mismatch: u64 = r
             .workloads
             .iter()
-            .map(|w| w.validation.counts.mismatch + w.validation.counted_path_differs)
+            .map(|w| w.agreement.counts.mismatch + w.agreement.counted_path_differs)
             .sum();
         let _ = writeln!(out, " {ambiguous:>9} {mismatch:>9}");
     }
@@ -91,7 +91,7 @@ pub fn summary_table(report: &Report) -> String {
 }
 
 /// Agreement with the reference per structure (all scenes and workloads) and overall, in the
-/// words of [`crate::agreement`], with the counts of every class.
+/// words of [`super::agreement`], with the counts of every class.
 fn write_agreement(out: &mut String, report: &Report) {
     let _ = writeln!(
         out,
@@ -118,8 +118,8 @@ fn write_agreement(out: &mut String, report: &Report) {
                 .flat_map(|r| &r.workloads)
                 .filter(|w| w.point_query == point_query);
             for w in workloads {
-                counts += w.validation.counts;
-                counted_differs += w.validation.counted_path_differs;
+                counts += w.agreement.counts;
+                counted_differs += w.agreement.counted_path_differs;
             }
             if counts.total() == 0 && counted_differs == 0 {
                 continue;
@@ -152,7 +152,7 @@ fn write_point_work(out: &mut String, report: &Report) {
         .iter()
         .flat_map(|r| r.workloads.iter().map(move |w| (r, w)))
         .filter(|(_, w)| w.point_query)
-        .filter_map(|(r, w)| w.counters_per_ray.map(|c| (r, w, c)))
+        .filter_map(|(r, w)| w.counters_per_query.map(|c| (r, w, c)))
         .collect();
     if rows.is_empty() {
         return;

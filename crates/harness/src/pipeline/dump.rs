@@ -37,11 +37,12 @@
 //! With numpy: `np.fromfile(path, dtype=[("index","<u4"),("flags","<u4"),("ray","<f4",8),
 //! ("t","<f4"),("prim","<u4"),("u","<f4"),("v","<f4")], offset=32)`.
 
+use super::measure::Answers;
 use crate::atomic::{ensure_writable_dir, write_atomic};
-use crate::measure::Answers;
 use anyhow::{Context, Result, bail, ensure};
 use raybench_accel::Hit;
 use raybench_geom::Ray;
+use raybench_scenes::Workload;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -252,7 +253,10 @@ impl DumpDir {
     /// `scene__structure__workload.hits`, with `-2`, `-3`… when two scene names map to the
     /// same file-safe name (`a:b` and `a-b`).
     fn unique_file_name(&mut self, scene: &str, structure: &str, workload: &str) -> String {
-        let stem = format!("{}__{structure}__{workload}", crate::render::slug(scene));
+        let stem = format!(
+            "{}__{structure}__{workload}",
+            crate::output::render::names::slug(scene)
+        );
         let file = (1..)
             .map(|k| match k {
                 1 => format!("{stem}.hits"),
@@ -269,12 +273,27 @@ impl DumpDir {
         let index = DumpIndex {
             format: format!(
                 "raybench hit dump v{VERSION}: {HEADER_BYTES}-byte header, {RECORD_BYTES}-byte \
-                 little-endian records (see README, \"Hit dumps\")"
+                 little-endian records (see docs/report-format.md, \"Hit dumps\")"
             ),
             files: self.files,
         };
         crate::report::write_json_atomic(&self.dir, "index.json", &index)
     }
+}
+
+/// The note a run or verify with `--dump-hits` and closest-point workloads carries.
+pub(crate) fn points_not_dumped(dumping: bool, workloads: &[Workload]) -> Option<String> {
+    let points: Vec<&str> = workloads
+        .iter()
+        .filter(|w| w.is_point_query())
+        .map(Workload::name)
+        .collect();
+    (dumping && !points.is_empty()).then(|| {
+        format!(
+            "--dump-hits covers ray workloads only: {} not dumped",
+            points.join(", ")
+        )
+    })
 }
 
 /// Reads `index.json` of a dump directory.

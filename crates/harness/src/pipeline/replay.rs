@@ -2,19 +2,18 @@
 //! double-precision recomputation over every triangle, with each answer's validation class
 //! against `embree-medium`. The ray comes from a report's `ray_bits` or verify's replay line.
 
+use super::check::verdict_name;
 use crate::registry::{self, BuildContext};
-use crate::validate::verdict_name;
 use anyhow::{Context, Result, bail};
 use raybench_accel::classify::{Tolerance, classify, classify_occlusion};
 use raybench_accel::{Accel, Hit};
 use raybench_geom::{DVec3, Ray, Triangle, TriangleMesh};
-use std::fmt::Write;
 
 /// The reference verdicts are computed against (the one `run` and `verify` use first).
 pub const VERDICT_REFERENCE: &str = "embree-medium";
 
 /// Structures always shown, whatever `--structure` asks for: the verify references.
-const ALWAYS_SHOWN: [&str; 3] = crate::verify::REFERENCES;
+const ALWAYS_SHOWN: [&str; 3] = super::verify::REFERENCES;
 
 /// Parses the 8 hex f32 bit patterns `ox,oy,oz,dx,dy,dz,tmin,tmax` (with or without `0x`,
 /// separated by commas and/or spaces; brackets and quotes from a pasted JSON array are
@@ -66,7 +65,7 @@ fn parse_hex_word(word: &str) -> Result<u32> {
     Ok(u32::from_str_radix(digits, 16)?)
 }
 
-fn join_bits(bits: &[u32; 8]) -> String {
+pub(crate) fn join_bits(bits: &[u32; 8]) -> String {
     bits.iter()
         .map(|b| format!("{b:#010x}"))
         .collect::<Vec<_>>()
@@ -223,98 +222,6 @@ pub fn replay(scene_spec: &str, structures: &[String], ray: Ray, seed: u64) -> R
         f64_answer: f64_answer(&mesh, &ray, &tol),
         answers,
     })
-}
-
-fn hit_text(h: &Option<Hit>) -> String {
-    match h {
-        Some(h) => format!(
-            "prim {} t {} ({:#010x}) u {} v {}",
-            h.prim,
-            h.t,
-            h.t.to_bits(),
-            h.u,
-            h.v
-        ),
-        None => "miss".to_string(),
-    }
-}
-
-fn crossing_text(x: &F64Crossing) -> String {
-    format!(
-        "prim {} t {:.17e} u {:.17e} v {:.17e}, {:.3e} {} the nearest edge (arbiter's edge tolerance {:.3e})",
-        x.prim,
-        x.t,
-        x.u,
-        x.v,
-        x.edge_distance.abs(),
-        if x.edge_distance >= 0.0 {
-            "inside"
-        } else {
-            "outside"
-        },
-        x.edge_tolerance
-    )
-}
-
-impl Replay {
-    /// The text `raybench replay` prints.
-    pub fn text(&self) -> String {
-        let mut out = String::new();
-        let r = &self.ray;
-        let (o, d) = (r.origin(), r.dir());
-        let _ = writeln!(
-            out,
-            "ray      origin ({}, {}, {})  dir ({}, {}, {})  t_min {}  t_max {}",
-            o.x,
-            o.y,
-            o.z,
-            d.x,
-            d.y,
-            d.z,
-            r.t_min(),
-            r.t_max()
-        );
-        let _ = writeln!(out, "bits     {}", join_bits(&r.to_bits()));
-        let _ = writeln!(
-            out,
-            "scene    {} ({} triangles traced, seed {})\n",
-            self.scene, self.triangles, self.seed
-        );
-        let f = &self.f64_answer;
-        let _ = writeln!(out, "double precision, every triangle:");
-        let _ = writeln!(
-            out,
-            "  closest hit:  {}",
-            f.hit.as_ref().map_or("miss".to_string(), crossing_text)
-        );
-        if let Some(m) = &f.nearest_miss {
-            let _ = writeln!(out, "  nearest miss: {}", crossing_text(m));
-        }
-        let w = self
-            .answers
-            .iter()
-            .map(|a| a.name.len())
-            .max()
-            .unwrap_or(9)
-            .max(9);
-        let _ = writeln!(
-            out,
-            "\n{:<w$}  {:<62}  {:<8}  verdict vs {VERDICT_REFERENCE} (closest / any)",
-            "structure", "closest hit", "any hit"
-        );
-        for a in &self.answers {
-            let _ = writeln!(
-                out,
-                "{:<w$}  {:<62}  {:<8}  {} / {}",
-                a.name,
-                hit_text(&a.closest),
-                if a.occluded { "occluded" } else { "clear" },
-                a.closest_verdict,
-                a.any_verdict
-            );
-        }
-        out
-    }
 }
 
 #[cfg(test)]

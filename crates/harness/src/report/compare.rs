@@ -1,10 +1,10 @@
-//! `raybench compare BASE.json NEW.json`: what changed between two reports, as a Markdown table
-//! for CI logs, and whether it is a regression.
+//! `raybench compare BASE.json NEW.json`: what changed between two reports, and whether it is a
+//! regression (the Markdown table for CI logs is drawn by [`crate::output::compare_table`]).
 //!
 //! Three kinds of figure, gated differently:
 //! * **correctness** — mismatches (plus counted-path disagreements) per scene × structure ×
 //!   workload: any rise fails, on any machine;
-//! * **deterministic figures** — counters per ray, SAH cost, nodes, leaves, references, depth:
+//! * **deterministic figures** — counters per query, SAH cost, nodes, leaves, references, depth:
 //!   the same seed gives the same numbers on every machine and thread count, so any change
 //!   fails (it is a change of algorithm, and the baseline must be regenerated on purpose);
 //! * **timing** — only as ratios to the reference measured in the same run (build time ratio,
@@ -14,9 +14,9 @@
 //! Entries in the base that the new report lacks fail too (a structure that stopped building is
 //! not "no regression"); entries only in the new report are listed as new.
 
-use crate::report::{Report, ResultEntry, WorkloadResult, is_point_workload, throughput_unit};
+use super::run::{Report, ResultEntry, WorkloadResult, is_point_workload, throughput_unit};
+use crate::output::compare_table::{markdown, row};
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
 /// How to judge timing ratios.
 #[derive(Clone, Copy, Debug)]
@@ -90,8 +90,9 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
     }
     // Shadow, diffuse and Whitted rays are generated from the reference's hits: with another
     // Embree build or ISA they may differ by an ulp, and so may the counters they produce.
-    let same_embree = base.environment.embree.version == new.environment.embree.version
-        && base.environment.embree.isa == new.environment.embree.isa;
+    let same_embree = base.header.environment.embree.version
+        == new.header.environment.embree.version
+        && base.header.environment.embree.isa == new.header.environment.embree.isa;
     let (b, n) = (keyed(base), keyed(new));
     let mut rows = Vec::new();
     for (key, be) in &b {
@@ -152,7 +153,7 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
 /// Warns about different machines and settings; returns whether deterministic figures are
 /// comparable (same seed, rays, workloads, suite and reference).
 fn environment_warnings(base: &Report, new: &Report, findings: &mut Vec<Finding>) -> bool {
-    let (be, ne) = (&base.environment, &new.environment);
+    let (be, ne) = (&base.header.environment, &new.header.environment);
     let machine = [
         ("CPU", be.cpu_model.clone(), ne.cpu_model.clone()),
         ("cores", be.cores.to_string(), ne.cores.to_string()),
@@ -301,7 +302,7 @@ fn compare_build_time(
 fn reference_name(e: &ResultEntry) -> String {
     e.workloads
         .first()
-        .map(|w| w.validation.reference.clone())
+        .map(|w| w.agreement.reference.clone())
         .unwrap_or_default()
 }
 
@@ -314,7 +315,7 @@ fn compare_workload(
     opts: &CompareOptions,
     findings: &mut Vec<Finding>,
 ) {
-    let bad = |w: &WorkloadResult| w.validation.counts.mismatch + w.validation.counted_path_differs;
+    let bad = |w: &WorkloadResult| w.agreement.counts.mismatch + w.agreement.counted_path_differs;
     if bad(n) > bad(b) {
         findings.push(Finding {
             severity: Severity::Regression,
@@ -347,7 +348,7 @@ fn compare_workload(
 }
 
 fn counters_text(w: &WorkloadResult) -> String {
-    match &w.counters_per_ray {
+    match &w.counters_per_query {
         None => "none".into(),
         Some(c) => format!(
             "nodes {:.3}, leaves {:.3}, prim tests {:.3}, cells {:.3}, mailbox skips {:.3} per {}",
@@ -383,129 +384,4 @@ fn timing_finding(
             ),
         });
     }
-}
-
-/// One table row: scene, structure, workload and the figures side by side.
-struct Row {
-    scene: String,
-    structure: String,
-    workload: String,
-    speed: (Option<f64>, Option<f64>),
-    build: (Option<f64>, Option<f64>),
-    counters: &'static str,
-    mismatches: (u64, u64),
-}
-
-fn row(
-    be: &ResultEntry,
-    ne: &ResultEntry,
-    bw: &WorkloadResult,
-    nw: &WorkloadResult,
-    comparable: bool,
-) -> Row {
-    Row {
-        scene: be.scene.clone(),
-        structure: be.structure.clone(),
-        workload: bw.workload.clone(),
-        speed: (bw.speedup_vs_reference, nw.speedup_vs_reference),
-        build: (be.build_ratio_to_reference, ne.build_ratio_to_reference),
-        counters: match (&bw.counters_total, comparable) {
-            (None, _) => "-",
-            (_, false) => "not comparable",
-            (Some(_), true) if bw.counters_total == nw.counters_total => "same",
-            _ => "CHANGED",
-        },
-        mismatches: (
-            bw.validation.counts.mismatch + bw.validation.counted_path_differs,
-            nw.validation.counts.mismatch + nw.validation.counted_path_differs,
-        ),
-    }
-}
-
-fn ratio_cell((b, n): (Option<f64>, Option<f64>), higher_is_better: bool) -> String {
-    match (b, n) {
-        (Some(b), Some(n)) => {
-            let change = if higher_is_better {
-                n / b - 1.0
-            } else {
-                b / n - 1.0
-            };
-            format!("{b:.3} → {n:.3} ({:+.1} %)", change * 100.0)
-        }
-        _ => "-".into(),
-    }
-}
-
-fn markdown(
-    base: &Report,
-    new: &Report,
-    rows: &[Row],
-    findings: &[Finding],
-    opts: &CompareOptions,
-) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "## raybench compare\n\nbase: {} ({}), new: {} ({})\n",
-        base.environment.git_revision,
-        base.environment.timestamp,
-        new.environment.git_revision,
-        new.environment.timestamp
-    );
-    let _ = writeln!(
-        s,
-        "Ratios are to `{}` in the same run (speed: higher is better; build: lower is better); \
-         the change is positive when the new report is better. Timing threshold {:.0} %{}.\n",
-        new.run.reference,
-        opts.max_slowdown * 100.0,
-        if opts.timing_advisory {
-            ", advisory"
-        } else {
-            ""
-        }
-    );
-    s.push_str(
-        "| scene | structure | workload | speed ratio | build ratio | counters | mismatches |\n",
-    );
-    s.push_str("|---|---|---|---:|---:|---|---:|\n");
-    for r in rows {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | {} | {} | {} → {} |",
-            r.scene,
-            r.structure,
-            r.workload,
-            ratio_cell(r.speed, true),
-            ratio_cell(r.build, false),
-            r.counters,
-            r.mismatches.0,
-            r.mismatches.1
-        );
-    }
-    let regressions = findings
-        .iter()
-        .filter(|f| f.severity == Severity::Regression)
-        .count();
-    let _ = writeln!(
-        s,
-        "\n{} regression(s), {} advisory, {} note(s).",
-        regressions,
-        findings
-            .iter()
-            .filter(|f| f.severity == Severity::Advisory)
-            .count(),
-        findings
-            .iter()
-            .filter(|f| f.severity == Severity::Note)
-            .count()
-    );
-    for f in findings {
-        let tag = match f.severity {
-            Severity::Regression => "REGRESSION",
-            Severity::Advisory => "advisory",
-            Severity::Note => "note",
-        };
-        let _ = writeln!(s, "- **{tag}**: {}", f.what);
-    }
-    s
 }

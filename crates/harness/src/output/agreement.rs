@@ -1,6 +1,6 @@
 //! How agreement is stated, wherever raybench states it (the run summary, the verify table):
 //! "0 mismatches in n rays (95% upper bound 3/n = …)", never "100 %", always with the counts of
-//! every validation class next to it (reliability.md §3.2, step 4).
+//! every validation class next to it (docs/validation.md, Comparison policy, item 5).
 
 use raybench_accel::classify::VerdictCounts;
 

@@ -1,8 +1,8 @@
 //! Checks a structure's answers against the reference's, ray by ray (or query point by query
 //! point), with the validation classes of `raybench_accel::classify` (and `classify_points`).
 
-use crate::measure::Answers;
-use crate::report::{DisputedPoint, DisputedRay, Validation};
+use super::measure::Answers;
+use crate::report::agreement::{Agreement, DisputedPoint, DisputedRay};
 use raybench_accel::classify::{Tolerance, Verdict, VerdictCounts, classify, classify_occlusion};
 use raybench_accel::classify_points::{classify_point, point_tolerance};
 use raybench_accel::{Accel, PointHit};
@@ -11,14 +11,14 @@ use raybench_geom::{Ray, TriangleMesh, Vec3};
 /// Disputed rays kept per class in the report.
 const KEEP_EXAMPLES: usize = 10;
 
+/// The two structures whose answers are checked against each other (any-hit disagreements
+/// are arbitrated by asking both for their closest hits).
 pub struct Sides<'a> {
     pub ours: &'a dyn Accel,
     pub reference: &'a dyn Accel,
     pub reference_name: &'a str,
 }
 
-/// Classifies every ray; also returns each ray's disagreement level (see [`disagreement`]). Any-hit disagreements are arbitrated through both sides' closest hits,
-/// computed for the disputed rays only.
 impl std::fmt::Debug for Sides<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Sides")
@@ -28,14 +28,17 @@ impl std::fmt::Debug for Sides<'_> {
     }
 }
 
-pub fn validate(
+/// Classifies every ray; also returns each ray's disagreement level (see `disagreement`).
+/// Any-hit disagreements are arbitrated through both sides' closest hits, computed for the
+/// disputed rays only.
+pub fn check_answers(
     mesh: &TriangleMesh,
     rays: &[Ray],
     ours: &Answers,
     reference: &Answers,
     sides: &Sides<'_>,
     tol: &Tolerance,
-) -> (Validation, Vec<u8>) {
+) -> (Agreement, Vec<u8>) {
     let mut counts = VerdictCounts::default();
     let mut levels = Vec::with_capacity(rays.len());
     let mut mismatches = Vec::new();
@@ -69,7 +72,7 @@ pub fn validate(
             bucket.push(DisputedRay::new(i, verdict_name(verdict), ray, a, b));
         }
     }
-    let mut v = Validation::new(sides.reference_name, counts);
+    let mut v = Agreement::new(sides.reference_name, counts);
     v.first_mismatches = mismatches;
     v.first_ambiguous = ambiguous;
     (v, levels)
@@ -100,14 +103,14 @@ pub fn verdict_name(v: Verdict) -> &'static str {
 /// Classifies every closest-point answer against the reference's (`classify_points`: the
 /// tolerance scales with the magnitude of the scene and the point); the first mismatches are
 /// kept with the point's bits.
-pub fn validate_points(
+pub fn check_points(
     mesh: &TriangleMesh,
     points: &[Vec3],
     radius: f32,
     ours: &[Option<PointHit>],
     reference: &[Option<PointHit>],
     reference_name: &str,
-) -> Validation {
+) -> Agreement {
     let bounds = mesh.bounds();
     let mut counts = VerdictCounts::default();
     let mut mismatches = Vec::new();
@@ -119,13 +122,13 @@ pub fn validate_points(
             mismatches.push(DisputedPoint::new(i, name, p, radius, a, b));
         }
     }
-    let mut v = Validation::new(reference_name, counts);
+    let mut v = Agreement::new(reference_name, counts);
     v.first_point_mismatches = mismatches;
     v
 }
 
 /// Queries where the counted walk answered differently from the timed path.
-pub fn count_point_differences(timed: &[Option<PointHit>], counted: &[Option<PointHit>]) -> u64 {
+pub fn counted_point_differences(timed: &[Option<PointHit>], counted: &[Option<PointHit>]) -> u64 {
     let differing = timed.iter().zip(counted).filter(|(a, b)| a != b).count();
     (differing + timed.len().abs_diff(counted.len())) as u64
 }
@@ -144,7 +147,7 @@ pub struct PathDifferences {
 }
 
 /// Compares the counted walk's answers with the timed path's, ray by ray.
-pub fn count_differences(
+pub fn counted_path_differences(
     mesh: &TriangleMesh,
     rays: &[Ray],
     timed: &Answers,

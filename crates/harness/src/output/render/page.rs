@@ -1,8 +1,9 @@
 //! `index.html`: one static page (no JavaScript) with the tables, charts, pictures and the
 //! environment fingerprint of a report.
 
-use super::{ChartFile, ScenePictures, scene_names, structure_names, workload_names};
-use crate::report::Report;
+use super::names::{scene_names, structure_names, workload_names};
+use super::{ChartFile, ScenePictures};
+use crate::report::run::{Report, throughput_unit};
 use std::fmt::Write as _;
 
 pub(crate) fn escape(s: &str) -> String {
@@ -23,7 +24,7 @@ img.px{image-rendering:pixelated;width:240px;border:1px solid #ddd}\
 
 pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictures]) -> String {
     let mut s = String::new();
-    let env = &report.environment;
+    let env = &report.header.environment;
     let title = match &report.run.suite {
         Some(suite) => format!("raybench: suite {suite}"),
         None => "raybench report".to_string(),
@@ -52,11 +53,11 @@ pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictu
             .results
             .iter()
             .flat_map(|r| &r.workloads)
-            .map(|w| w.validation.rays())
+            .map(|w| w.agreement.queries())
             .sum::<u64>()
     );
     results_table(&mut s, report);
-    validation_table(&mut s, report);
+    agreement_table(&mut s, report);
     s.push_str("<h2>Charts</h2>\n");
     for c in charts {
         let _ = writeln!(
@@ -81,7 +82,7 @@ fn results_table(s: &mut String, report: &Report) {
                 <th>triangles</th><th>build ms (× ref)</th><th>bytes / triangle</th><th>SAH</th>",
     );
     for w in &workloads {
-        let unit = crate::report::throughput_unit(w);
+        let unit = throughput_unit(w);
         let _ = write!(s, "<th>{} {unit} (× ref)</th>", escape(w));
     }
     s.push_str("<th>mismatches</th></tr>\n");
@@ -114,7 +115,7 @@ fn results_table(s: &mut String, report: &Report) {
                         let _ = write!(
                             s,
                             "<td>{:.2} ({})</td>",
-                            x.mrays_per_s.median,
+                            x.mqueries_per_s.median,
                             ratio(x.speedup_vs_reference)
                         );
                     }
@@ -124,7 +125,7 @@ fn results_table(s: &mut String, report: &Report) {
             let bad: u64 = r
                 .workloads
                 .iter()
-                .map(|w| w.validation.counts.mismatch + w.validation.counted_path_differs)
+                .map(|w| w.agreement.counts.mismatch + w.agreement.counted_path_differs)
                 .sum();
             let _ = writeln!(
                 s,
@@ -140,7 +141,7 @@ fn ratio(r: Option<f64>) -> String {
     r.map_or("-".into(), |r| format!("{r:.2}×"))
 }
 
-fn validation_table(s: &mut String, report: &Report) {
+fn agreement_table(s: &mut String, report: &Report) {
     s.push_str(
         "<h2>Validation</h2>\n<table><tr><th class=\"l\">structure</th><th>rays</th><th>both miss</th>\
          <th>exact</th><th>within tolerance</th><th>tie</th><th>boundary</th><th>edge ambiguous</th>\
@@ -155,8 +156,8 @@ fn validation_table(s: &mut String, report: &Report) {
             .filter(|r| r.structure == st)
             .flat_map(|r| &r.workloads)
         {
-            c += w.validation.counts;
-            differs += w.validation.counted_path_differs;
+            c += w.agreement.counts;
+            differs += w.agreement.counted_path_differs;
         }
         let _ = writeln!(
             s,
@@ -233,7 +234,7 @@ fn notes(s: &mut String, report: &Report) {
 
 fn environment(s: &mut String, report: &Report) {
     s.push_str("<h2>Environment</h2>\n<table>\n");
-    let env = serde_json::to_value(&report.environment).unwrap_or_default();
+    let env = serde_json::to_value(&report.header.environment).unwrap_or_default();
     let run = serde_json::to_value(&report.run).unwrap_or_default();
     for (section, value) in [("environment", env), ("run", run)] {
         if let serde_json::Value::Object(map) = value {

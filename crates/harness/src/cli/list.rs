@@ -1,0 +1,47 @@
+//! `raybench list`: the structures, scene generators, real scenes, workloads and suites.
+
+use super::scene::{write_generators, write_real_scenes};
+use crate::registry;
+use anyhow::Result;
+use raybench_scenes::Workload;
+use std::io::Write;
+use std::process::ExitCode;
+
+pub fn run() -> Result<ExitCode> {
+    println!("Structures:");
+    for e in registry::registry() {
+        let limit = e
+            .suite_triangle_limit
+            .map(|l| format!(" (suites: up to {l} triangles)"))
+            .unwrap_or_default();
+        println!("  {:<24} {}{limit}", e.name, e.description);
+    }
+    let mut out = std::io::stdout().lock();
+    writeln!(out)?;
+    write_generators(&mut out, false)?;
+    writeln!(out)?;
+    write_real_scenes(&mut out)?;
+    drop(out);
+    println!("\nWorkloads:");
+    for w in Workload::ALL {
+        println!("  {:<24} {}", w.name(), w.description());
+    }
+    println!("\nSuites ({}):", raybench_scenes::suites_dir().display());
+    for (path, suite) in raybench_scenes::list_suites()? {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default();
+        println!(
+            "  {stem:<24} {} ({} scenes, {} rays{})",
+            suite.description,
+            suite.scenes.len(),
+            suite.rays,
+            suite
+                .points
+                .map(|p| format!(", {p} points"))
+                .unwrap_or_default()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,65 @@
+//! `raybench verify`: check answers, not speed, against three references; write verify.json.
+
+use super::{
+    DEFAULT_POINTS, Defaults, Selection, all_structures, budget, check_outputs, default_out_dir,
+    exit_status,
+};
+use crate::output::verify_table::verify_table;
+use crate::pipeline::verify::{BRUTE_FORCE_BUDGET, VerifyOptions, verify};
+use anyhow::Result;
+use clap::Args;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Args, Debug)]
+pub struct VerifyArgs {
+    #[command(flatten)]
+    pub selection: Selection,
+    /// Output directory for verify.json (default: reports/<date>-<revision>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Write every ray and each structure's answer here (see docs/report-format.md, "Hit dumps").
+    #[arg(long)]
+    pub dump_hits: Option<PathBuf>,
+    /// Ray–triangle tests brute force may spend per scene × workload (it checks an evenly
+    /// spaced subsample when a workload would cost more).
+    #[arg(long, default_value_t = BRUTE_FORCE_BUDGET, value_parser = budget)]
+    pub brute_force_budget: u64,
+}
+
+/// `raybench verify`: exit 0 with no mismatch, 2 on any mismatch (or counted-path
+/// difference), 1 on errors.
+pub fn run(args: VerifyArgs) -> Result<ExitCode> {
+    // Verify checks every registered structure unless told otherwise: a suite's structure list
+    // says what is worth timing, not what may go unchecked.
+    let defaults = Defaults {
+        structures: all_structures(),
+        rays: 10_000,
+        points: DEFAULT_POINTS,
+    };
+    let r = args.selection.resolve(false, defaults)?;
+    let dir = args.out.unwrap_or_else(default_out_dir);
+    check_outputs(&dir, args.dump_hits.as_deref())?;
+    let opts = VerifyOptions {
+        suite: args.selection.suite.clone(),
+        structures: r.structures,
+        workloads: r.workloads,
+        rays: r.rays,
+        points: r.points,
+        threads: args.selection.threads,
+        seed: args.selection.seed,
+        ftz_daz: args.selection.ftz_daz,
+        progress: std::io::stdout().is_terminal(),
+        brute_force_budget: args.brute_force_budget,
+        dump_hits: args.dump_hits.clone(),
+    };
+    let report = verify(&opts, &r.requests)?;
+    let path = report.write_atomic(&dir)?;
+    print!("{}", verify_table(&report));
+    println!("verify: {}", path.display());
+    if let Some(d) = &args.dump_hits {
+        println!("hit dumps: {}", d.display());
+    }
+    Ok(exit_status(report.mismatches(), report.errors.len()))
+}

@@ -1,0 +1,54 @@
+//! `raybench watertight`: crack hunting; write watertight.json and print the miss rates.
+
+use super::{all_structures, at_least_one, budget, default_out_dir, exit_status, pick};
+use crate::atomic::ensure_writable_dir;
+use crate::output::watertight_table::watertight_table;
+use crate::pipeline::verify::BRUTE_FORCE_BUDGET;
+use crate::pipeline::watertight::{WatertightOptions, default_cases, watertight};
+use crate::registry;
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Args, Debug)]
+pub struct WatertightArgs {
+    /// Structures, comma-separated (default: every registered one).
+    #[arg(long, value_delimiter = ',')]
+    pub structures: Vec<String>,
+    /// Rays generated per case.
+    #[arg(long, default_value_t = 100_000, value_parser = at_least_one)]
+    pub rays: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Worker threads for builds and traces.
+    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
+    pub threads: usize,
+    /// Output directory for watertight.json (default: reports/<date>-<revision>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Ray–triangle tests brute force may spend per case (it traces an evenly spaced subsample).
+    #[arg(long, default_value_t = BRUTE_FORCE_BUDGET, value_parser = budget)]
+    pub brute_force_budget: u64,
+}
+
+/// `raybench watertight`: exit 0, or 1 on errors (a crack is a figure, not a failure).
+pub fn run(args: WatertightArgs) -> Result<ExitCode> {
+    let structures = pick(args.structures, None, all_structures);
+    registry::select(&structures)?;
+    let dir = args.out.unwrap_or_else(default_out_dir);
+    ensure_writable_dir(&dir).context("--out")?;
+    let opts = WatertightOptions {
+        cases: default_cases(),
+        structures,
+        rays: args.rays,
+        seed: args.seed,
+        threads: args.threads,
+        brute_force_budget: args.brute_force_budget,
+    };
+    let report = watertight(&opts)?;
+    let path = report.write_atomic(&dir)?;
+    print!("{}", watertight_table(&report));
+    println!("watertight: {}", path.display());
+    Ok(exit_status(0, report.errors.len()))
+}

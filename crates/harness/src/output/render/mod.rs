@@ -1,0 +1,134 @@
+//! `raybench report`: charts, pictures and one static HTML page, drawn from `report.json` alone.
+//!
+//! Output layout under the chosen directory:
+//! * `charts/*.svg` — build time, Mrays/s (Mqueries/s for closest-point workloads) and ratios
+//!   to the reference per workload, memory per triangle, counters per query, scaling curves
+//!   with reference slopes (when one scene family comes in three or more sizes), break-even per
+//!   scene, validation classes;
+//! * `images/*.png` — per scene and structure: traversal-cost heatmap (one colour scale per
+//!   scene), shaded render, disagreement mask; one legend colour bar;
+//! * `index.html` — tables, the charts, the pictures and the environment; no JavaScript.
+//!
+//! Every file is written atomically (a temporary file, then a rename).
+
+pub mod charts;
+mod figures;
+pub mod names;
+mod page;
+pub mod pictures;
+mod scaling;
+
+use crate::atomic::write_atomic;
+use crate::report::run::{Report, ResultEntry};
+use anyhow::{Context, Result};
+use figures::all_charts;
+use names::{scene_names, scene_slugs, slug};
+use std::path::{Path, PathBuf};
+
+/// Chart size in pixels (SVG user units).
+const W: u32 = 1100;
+const H: u32 = 520;
+
+/// What `render` wrote, for the caller to print.
+#[derive(Debug, Default)]
+pub struct Rendered {
+    pub charts: Vec<PathBuf>,
+    pub images: Vec<PathBuf>,
+    pub index: PathBuf,
+}
+
+/// A chart as the page shows it.
+#[derive(Clone, Debug)]
+pub(crate) struct ChartFile {
+    pub file: String,
+    pub caption: String,
+}
+
+/// Pictures of one scene.
+#[derive(Clone, Debug)]
+pub(crate) struct ScenePictures {
+    pub scene: String,
+    pub max_cost: u16,
+    pub downsample: u32,
+    /// (structure, heatmap file if counted, render file, mask file)
+    pub rows: Vec<(String, Option<String>, String, String)>,
+}
+
+pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
+    std::fs::create_dir_all(dir.join("charts"))
+        .with_context(|| format!("creating {}", dir.display()))?;
+    std::fs::create_dir_all(dir.join("images"))
+        .with_context(|| format!("creating {}", dir.display()))?;
+    let mut out = Rendered::default();
+    let mut chart_files = Vec::new();
+    for (file, caption, svg) in all_charts(report)? {
+        let path = dir.join("charts").join(&file);
+        write_atomic(&path, svg.as_bytes())?;
+        out.charts.push(path);
+        chart_files.push(ChartFile {
+            file: format!("charts/{file}"),
+            caption,
+        });
+    }
+    let pictures = write_pictures(report, dir, &mut out.images)?;
+    let page = page::page(report, &chart_files, &pictures);
+    out.index = dir.join("index.html");
+    write_atomic(&out.index, page.as_bytes())?;
+    Ok(out)
+}
+
+fn write_pictures(
+    report: &Report,
+    dir: &Path,
+    written: &mut Vec<PathBuf>,
+) -> Result<Vec<ScenePictures>> {
+    let legend = dir.join("images").join("legend-viridis.png");
+    pictures::write_legend(&legend)?;
+    written.push(legend);
+    let mut out = Vec::new();
+    let slugs = scene_slugs(report);
+    for scene in scene_names(report) {
+        let entries: Vec<&ResultEntry> = report
+            .results
+            .iter()
+            .filter(|r| r.scene == scene && r.primary_image.is_some())
+            .collect();
+        if entries.is_empty() {
+            continue;
+        }
+        let images: Vec<_> = entries
+            .iter()
+            .filter_map(|r| r.primary_image.as_ref())
+            .collect();
+        let max = pictures::shared_max(&images);
+        let mut rows = Vec::new();
+        for r in &entries {
+            let img = r.primary_image.as_ref().expect("filtered");
+            let base = format!("{}--{}", slugs[&scene], slug(&r.structure));
+            let file = |kind: &str| format!("images/{base}-{kind}.png");
+            let heat = match pictures::heatmap_pixels(img, max)? {
+                Some(px) => {
+                    let f = file("cost");
+                    pictures::write(&px, img, &dir.join(&f))?;
+                    written.push(dir.join(&f));
+                    Some(f)
+                }
+                None => None,
+            };
+            let render = file("render");
+            pictures::write(&pictures::shade_pixels(img)?, img, &dir.join(&render))?;
+            let mask = file("disagree");
+            pictures::write(&pictures::disagree_pixels(img)?, img, &dir.join(&mask))?;
+            written.push(dir.join(&render));
+            written.push(dir.join(&mask));
+            rows.push((r.structure.clone(), heat, render, mask));
+        }
+        out.push(ScenePictures {
+            scene,
+            max_cost: max,
+            downsample: images[0].downsample,
+            rows,
+        });
+    }
+    Ok(out)
+}

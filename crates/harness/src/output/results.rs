@@ -1,0 +1,364 @@
+//! `raybench results`: a report's figures as one Markdown page, the kind kept in
+//! `docs/results/<date>.md` beside the report it was made from. The page is generated, never
+//! typed by hand: a heading naming the run and linking its report; the headline (per structure,
+//! the geometric mean over scenes of each ratio to the reference, and one sentence on
+//! agreement); one table per scene; the SAH cost of every structure that has one.
+
+use super::agreement::class_counts;
+use super::summary::sig;
+use crate::report::run::{Report, ResultEntry, is_point_workload, throughput_unit};
+use raybench_accel::classify::VerdictCounts;
+use std::fmt::Write;
+
+/// The geometric mean of the positive finite values, `None` when there is none. A ratio that
+/// is zero or missing (a structure skipped on a scene, a reference too fast to time) leaves
+/// the scene out rather than pulling the mean to zero.
+pub fn geometric_mean(values: impl IntoIterator<Item = f64>) -> Option<f64> {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for v in values.into_iter().filter(|v| v.is_finite() && *v > 0.0) {
+        sum += v.ln();
+        n += 1;
+    }
+    (n > 0).then(|| (sum / n as f64).exp())
+}
+
+/// One row of the headline: a structure's geometric means over the scenes it ran on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeadlineRow {
+    pub structure: String,
+    /// Throughput relative to the reference (higher is faster), one per workload of the run.
+    pub workloads: Vec<Option<f64>>,
+    /// Build time relative to the reference (lower is faster).
+    pub build: Option<f64>,
+    /// Bytes held relative to the reference (lower is smaller).
+    pub memory: Option<f64>,
+    /// Scenes the structure has a result on.
+    pub scenes: usize,
+}
+
+/// The headline rows: every structure of the run but the reference, in the run's order.
+pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
+    let reference = &report.run.reference;
+    let reference_on = |scene: &str| {
+        report
+            .results
+            .iter()
+            .find(|r| r.scene == scene && &r.structure == reference)
+    };
+    structures(report)
+        .into_iter()
+        .filter(|s| s != reference)
+        .map(|structure| {
+            let entries: Vec<&ResultEntry> = report
+                .results
+                .iter()
+                .filter(|r| r.structure == structure)
+                .collect();
+            let workloads = report
+                .run
+                .workloads
+                .iter()
+                .map(|wl| {
+                    geometric_mean(entries.iter().filter_map(|r| {
+                        r.workloads
+                            .iter()
+                            .find(|w| &w.workload == wl)
+                            .and_then(|w| w.speedup_vs_reference)
+                    }))
+                })
+                .collect();
+            let build = geometric_mean(entries.iter().filter_map(|r| r.build_ratio_to_reference));
+            let memory = geometric_mean(entries.iter().filter_map(|r| {
+                let base = reference_on(&r.scene)?.memory_bytes;
+                (base > 0).then(|| r.memory_bytes as f64 / base as f64)
+            }));
+            HeadlineRow {
+                structure,
+                workloads,
+                build,
+                memory,
+                scenes: entries.len(),
+            }
+        })
+        .collect()
+}
+
+/// Structures in the run's order, then any other that has results.
+fn structures(report: &Report) -> Vec<String> {
+    let mut names: Vec<String> = report
+        .run
+        .structures
+        .iter()
+        .filter(|s| report.results.iter().any(|r| &r.structure == *s))
+        .cloned()
+        .collect();
+    for r in &report.results {
+        if !names.contains(&r.structure) {
+            names.push(r.structure.clone());
+        }
+    }
+    names
+}
+
+/// Scenes in the order the report lists them, then any other that has results.
+fn scenes(report: &Report) -> Vec<String> {
+    let mut names: Vec<String> = report.scenes.iter().map(|s| s.name.clone()).collect();
+    for r in &report.results {
+        if !names.contains(&r.scene) {
+            names.push(r.scene.clone());
+        }
+    }
+    names
+}
+
+/// A ratio with two decimals; one too small for two decimals to show in scientific notation
+/// (brute force runs at about 1e-4 of the reference's speed).
+pub fn ratio_text(x: f64) -> String {
+    if x >= 0.005 {
+        format!("{x:.2}")
+    } else {
+        format!("{x:.1e}")
+    }
+}
+
+fn cell(x: Option<f64>) -> String {
+    x.map_or("-".to_string(), ratio_text)
+}
+
+/// The headline table and the agreement sentence (what `--headline-only` prints, for pasting
+/// into the README).
+pub fn headline(report: &Report) -> String {
+    let mut s = String::new();
+    let workloads = &report.run.workloads;
+    s.push_str("| structure |");
+    for w in workloads {
+        let _ = write!(s, " {w} |");
+    }
+    s.push_str(" build | memory |\n|---|");
+    s.push_str(&"---:|".repeat(workloads.len() + 2));
+    s.push('\n');
+    let rows = headline_rows(report);
+    for row in &rows {
+        let _ = write!(s, "| {} |", row.structure);
+        for w in &row.workloads {
+            let _ = write!(s, " {} |", cell(*w));
+        }
+        let _ = writeln!(s, " {} | {} |", cell(row.build), cell(row.memory));
+    }
+    let all_scenes = scenes(report).len();
+    let fewer: Vec<String> = rows
+        .iter()
+        .filter(|r| r.scenes < all_scenes)
+        .map(|r| format!("{} ({} of {all_scenes})", r.structure, r.scenes))
+        .collect();
+    if !fewer.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nOver fewer scenes (skipped where a suite limits them, or failed): {}.",
+            fewer.join(", ")
+        );
+    }
+    let _ = writeln!(s, "\n{}", agreement_line(report));
+    s
+}
+
+/// "Agreement with embree-medium: 0 mismatches in N comparisons (…)", or the count.
+fn agreement_line(report: &Report) -> String {
+    let mut counts = VerdictCounts::default();
+    let mut counted_differs = 0;
+    for w in report.results.iter().flat_map(|r| &r.workloads) {
+        counts += w.agreement.counts;
+        counted_differs += w.agreement.counted_path_differs;
+    }
+    let mismatches = match counts.mismatch {
+        1 => "1 mismatch".to_string(),
+        k => format!("{k} mismatches"),
+    };
+    let mut line = format!(
+        "Agreement with `{}`: {mismatches} in {} comparisons, one per query of every \
+         structure, scene and workload ({})",
+        report.run.reference,
+        counts.total(),
+        class_counts(&counts)
+    );
+    if counted_differs > 0 {
+        let _ = write!(
+            line,
+            "; the counted path answered differently from the timed path on {counted_differs} \
+             queries"
+        );
+    }
+    line.push('.');
+    line
+}
+
+/// The whole page; `report_link` is where the heading's link to the report points.
+pub fn results_page(report: &Report, report_link: &str) -> String {
+    let env = &report.header.environment;
+    let run = &report.run;
+    let date = env.timestamp.get(..10).unwrap_or(&env.timestamp);
+    let revision: String = env.git_revision.chars().take(10).collect();
+    let mut s = String::new();
+    let _ = writeln!(s, "# Results of {date} (revision {revision})\n");
+    let points = if run.workloads.iter().any(|w| is_point_workload(w)) {
+        format!(", {} points per closest-point workload", run.points)
+    } else {
+        String::new()
+    };
+    let _ = writeln!(
+        s,
+        "Suite `{}`, {} thread(s), {} rays per ray workload{points}, seed {}, on {} ({} cores); \
+         every answer checked against `{}`. Report: [{report_link}]({report_link}).\n",
+        run.suite.as_deref().unwrap_or("none"),
+        run.threads,
+        run.rays,
+        run.seed,
+        env.cpu_model,
+        env.cores,
+        run.reference
+    );
+    let _ = writeln!(
+        s,
+        "Generated by `raybench results` from the report; do not edit by hand.\n"
+    );
+    let _ = writeln!(
+        s,
+        "## Headline\n\nGeometric mean over the scenes of each structure's throughput relative \
+         to `{}` in the same run (Mrays/s for ray workloads, Mqueries/s for closest-point \
+         workloads; higher is faster), and of its build time and memory relative to `{}` \
+         (lower is faster or smaller).\n",
+        run.reference, run.reference
+    );
+    s.push_str(&headline(report));
+    scene_tables(&mut s, report);
+    sah_table(&mut s, report);
+    if !report.notes.is_empty() || !report.errors.is_empty() {
+        s.push_str("\n## Notes\n\n");
+        for n in &report.notes {
+            let _ = writeln!(s, "- {n}");
+        }
+        for e in &report.errors {
+            let _ = writeln!(s, "- error: {e}");
+        }
+    }
+    s
+}
+
+/// Per scene: build ms (ratio), memory MB, and throughput per workload with its ratio.
+fn scene_tables(s: &mut String, report: &Report) {
+    let workloads = &report.run.workloads;
+    s.push_str("\n## Scenes\n\nBuild time (median) and throughput (median) with the ratio to the reference in parentheses.\n");
+    for scene in scenes(report) {
+        let entries: Vec<&ResultEntry> = structures(report)
+            .iter()
+            .filter_map(|st| {
+                report
+                    .results
+                    .iter()
+                    .find(|r| r.scene == scene && &r.structure == st)
+            })
+            .collect();
+        let Some(first) = entries.first() else {
+            continue;
+        };
+        let _ = writeln!(
+            s,
+            "\n### {scene}\n\n{} triangles.\n",
+            first.triangles.traced
+        );
+        s.push_str("| structure | build ms | memory MB |");
+        for w in workloads {
+            let _ = write!(s, " {w} {} |", throughput_unit(w));
+        }
+        s.push_str("\n|---|");
+        s.push_str(&"---:|".repeat(workloads.len() + 2));
+        s.push('\n');
+        for r in entries {
+            let _ = write!(
+                s,
+                "| {} | {} ({}) | {} |",
+                r.structure,
+                sig(r.build.median_ms),
+                cell(r.build_ratio_to_reference),
+                sig(r.memory_bytes as f64 / 1e6)
+            );
+            for wl in workloads {
+                match r.workloads.iter().find(|w| &w.workload == wl) {
+                    Some(w) => {
+                        let _ = write!(
+                            s,
+                            " {} ({}) |",
+                            sig(w.mqueries_per_s.median),
+                            cell(w.speedup_vs_reference)
+                        );
+                    }
+                    None => s.push_str(" - |"),
+                }
+            }
+            s.push('\n');
+        }
+    }
+}
+
+/// SAH cost per scene × structure, for the structures that have one.
+fn sah_table(s: &mut String, report: &Report) {
+    let with_sah: Vec<String> = structures(report)
+        .into_iter()
+        .filter(|st| {
+            report
+                .results
+                .iter()
+                .any(|r| &r.structure == st && r.build_stats.sah_cost.is_some())
+        })
+        .collect();
+    if with_sah.is_empty() {
+        return;
+    }
+    s.push_str(
+        "\n## SAH cost\n\nThe surface area heuristic's cost of each tree (a node step and a \
+         triangle test both cost 1).\n\n| scene |",
+    );
+    for st in &with_sah {
+        let _ = write!(s, " {st} |");
+    }
+    s.push_str("\n|---|");
+    s.push_str(&"---:|".repeat(with_sah.len()));
+    s.push('\n');
+    for scene in scenes(report) {
+        let _ = write!(s, "| {scene} |");
+        for st in &with_sah {
+            let cost = report
+                .results
+                .iter()
+                .find(|r| r.scene == scene && &r.structure == st)
+                .and_then(|r| r.build_stats.sah_cost);
+            let _ = write!(
+                s,
+                " {} |",
+                cost.map_or("-".to_string(), |c| format!("{c:.2}"))
+            );
+        }
+        s.push('\n');
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn geometric_means_skip_what_cannot_be_a_ratio() {
+        let g = geometric_mean([2.0, 8.0]).unwrap();
+        assert!((g - 4.0).abs() < 1e-12, "{g}");
+        assert_eq!(geometric_mean([0.0, f64::NAN, -1.0]), None);
+        let g = geometric_mean([3.0, 0.0]).unwrap();
+        assert!((g - 3.0).abs() < 1e-12, "a zero leaves its scene out: {g}");
+    }
+
+    #[test]
+    fn ratios_keep_two_decimals_unless_too_small_to_show() {
+        assert_eq!(ratio_text(1.234), "1.23");
+        assert_eq!(ratio_text(0.005), "0.01");
+        assert_eq!(ratio_text(0.000123), "1.2e-4");
+    }
+}

@@ -1,0 +1,299 @@
+//! `raybench run`: load scenes, generate one ray set (or query point set) per workload from the
+//! reference, build and time every structure, count, check every answer, and assemble the report.
+//!
+//! Ray workloads and closest-point workloads share the pipeline (build once, warm-up + median
+//! of timed passes, an untimed counted pass, every answer checked against the reference) but
+//! not the code that handles rays: `SceneRun` keeps the two kinds in separate lists.
+
+use super::check::{
+    Sides, check_answers, check_points, counted_path_differences, counted_point_differences,
+};
+use super::dump::{DumpDir, points_not_dumped};
+use super::images::{PixelInput, PrimaryImage, shade};
+use super::measure::{
+    Answers, count_pass, count_point_pass, time_builds, time_point_queries, time_traces,
+};
+use super::scenes::for_each_scene;
+use super::workers::{Log, Progress, Workers, catch_panic};
+use super::workloads::{PreparedPoints, QueryCounts, SceneRun, prepare_workload, triangle_counts};
+use crate::registry::{self, BuildContext, StructureEntry};
+use crate::report::Header;
+use crate::report::run::*;
+use anyhow::Result;
+use raybench_accel::Accel;
+use raybench_accel::classify::Tolerance;
+use raybench_scenes::{SceneRequest, WhittedParams, Workload};
+use std::path::PathBuf;
+
+/// Everything `raybench run` needs; the CLI fills it from flags and the suite manifest.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    pub suite: Option<String>,
+    pub structures: Vec<String>,
+    pub workloads: Vec<Workload>,
+    pub rays: usize,
+    /// Query points per closest-point workload.
+    pub points: usize,
+    pub threads: usize,
+    pub reference: String,
+    pub seed: u64,
+    pub build_runs: usize,
+    pub trace_runs: usize,
+    pub ftz_daz: bool,
+    pub progress: bool,
+    /// Keep per-pixel pictures of the primary workload in the report (see `images`); off for
+    /// baselines, which are compared, not looked at.
+    pub images: bool,
+    /// Write every structure's answers to every workload here (see [`super::dump`]).
+    pub dump_hits: Option<PathBuf>,
+}
+
+/// Runs everything and returns the report (not yet written). With `dump_hits`, every
+/// structure's answers are written there as they are measured (see [`super::dump`]).
+pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
+    anyhow::ensure!(opts.rays >= 1, "--rays must be at least 1 (got 0)");
+    anyhow::ensure!(opts.points >= 1, "--points must be at least 1 (got 0)");
+    let mut structures = registry::select(&opts.structures)?;
+    let reference_entry = registry::find(&opts.reference)?;
+    let mut log = Log::default();
+    if !structures.iter().any(|e| e.name == reference_entry.name) {
+        log.notes.push(format!(
+            "reference {} added to the measured structures so ratios can be computed",
+            opts.reference
+        ));
+        structures.insert(0, registry::find(&opts.reference)?);
+    }
+    let mut dump = opts.dump_hits.as_deref().map(DumpDir::create).transpose()?;
+    log.notes
+        .extend(points_not_dumped(dump.is_some(), &opts.workloads));
+    let workers = Workers::start(opts.threads, opts.ftz_daz)?;
+    let tol = Tolerance::default();
+    let progress = Progress::new(
+        opts.progress,
+        (scenes.len() * (structures.len() + 1)) as u64,
+    );
+    let mut report = Report {
+        header: Header::new(SCHEMA_VERSION, workers.environment.clone()),
+        run: RunSettings {
+            suite: opts.suite.clone(),
+            seed: opts.seed,
+            rays: opts.rays,
+            points: opts.points,
+            threads: opts.threads,
+            reference: opts.reference.clone(),
+            build_runs: opts.build_runs,
+            trace_runs: opts.trace_runs,
+            tolerance: tol,
+            structures: structures.iter().map(|e| e.name.to_string()).collect(),
+            workloads: opts
+                .workloads
+                .iter()
+                .map(|w| w.name().to_string())
+                .collect(),
+            whitted: WhittedParams::default(),
+        },
+        scenes: Vec::new(),
+        results: Vec::new(),
+        notes: Vec::new(),
+        errors: Vec::new(),
+    };
+    let explicit = opts.suite.is_none();
+    workers.pool.install(|| {
+        for_each_scene(scenes, opts.seed, &progress, &mut log, |_, scene, log| {
+            let name = &scene.scene.name;
+            progress.step(format!("{name}: generating workloads with {}", reference_entry.name));
+            let prepared = catch_panic(|| {
+                let counts = QueryCounts { rays: opts.rays, points: opts.points };
+                SceneRun::prepare(scene, &opts.workloads, counts, opts.seed, opts.threads, &reference_entry)
+            });
+            let sr = match prepared {
+                Ok(sr) => sr,
+                Err(e) => return log.errors.push(format!("scene {name}: {e:#}")),
+            };
+            report.scenes.push(sr.record(scene));
+            for entry in &structures {
+                if let Some(limit) = entry.suite_triangle_limit.filter(|&l| !explicit && scene.scene.mesh.len() > l) {
+                    log.notes.push(format!(
+                        "{} skipped on {name} ({} triangles > its suite limit {limit}); name it with --structures to run it",
+                        entry.name,
+                        scene.scene.mesh.len()
+                    ));
+                    progress.step(format!("{name}: {} skipped", entry.name));
+                    continue;
+                }
+                progress.step(format!("{name}: {}", entry.name));
+                match catch_panic(|| sr.measure(entry, opts, &tol, dump.as_mut())) {
+                    Ok(r) => report.results.push(r),
+                    Err(e) => log.errors.push(format!("{} on {name}: {e:#}", entry.name)),
+                }
+            }
+        });
+    });
+    progress.finish();
+    report.notes.append(&mut log.notes);
+    report.errors.append(&mut log.errors);
+    if let Some(dump) = dump {
+        dump.finish()?;
+    }
+    fill_ratios(&mut report);
+    Ok(report)
+}
+
+impl SceneRun<'_> {
+    fn measure(
+        &self,
+        entry: &StructureEntry,
+        opts: &RunOptions,
+        tol: &Tolerance,
+        mut dump: Option<&mut DumpDir>,
+    ) -> Result<ResultEntry> {
+        let s = &self.scene.scene;
+        let ctx = BuildContext {
+            threads: opts.threads,
+        };
+        let (built, build) = time_builds(entry, &s.mesh, &ctx, opts.build_runs)?;
+        let accel = built.accel.as_ref();
+        let mut workloads = Vec::new();
+        let mut primary_image = None;
+        for wl in self.workloads.iter().filter(|w| !w.rays.is_empty()) {
+            let any_hit = wl.workload.any_hit();
+            let prepared = prepare_workload(accel, wl.workload, &wl.rays).map_err(|e| {
+                anyhow::anyhow!(
+                    "{} rays rejected by {}: {e}",
+                    wl.workload.name(),
+                    entry.name
+                )
+            })?;
+            let (answers, mrays) = time_traces(
+                accel,
+                &wl.rays,
+                &prepared,
+                any_hit,
+                opts.threads,
+                opts.trace_runs,
+            );
+            let (counted, counters, work) = count_pass(accel, &wl.rays, any_hit);
+            let sides = Sides {
+                ours: accel,
+                reference: self.reference.as_ref(),
+                reference_name: &self.reference_name,
+            };
+            let (mut agreement, levels) =
+                check_answers(&s.mesh, &wl.rays, &answers, &wl.reference, &sides, tol);
+            let paths = counted_path_differences(&s.mesh, &wl.rays, &answers, &counted, tol);
+            agreement.counted_path_differs = paths.differs;
+            agreement.counted_path_ties = paths.ties;
+            if let Some(d) = dump.as_deref_mut() {
+                d.write(
+                    &s.name,
+                    entry.name,
+                    wl.workload.name(),
+                    &wl.rays,
+                    None,
+                    &answers,
+                )?;
+            }
+            let has_counters = accel.has_counters();
+            if let (true, Some((w, h)), Answers::Closest(hits)) = (opts.images, wl.size, &answers) {
+                let pixels: Vec<PixelInput> = (0..wl.rays.len())
+                    .map(|i| PixelInput {
+                        cost: has_counters.then_some(work[i]),
+                        shade: shade(&s.mesh, &wl.rays[i], hits[i].as_ref()),
+                        disagree: levels[i],
+                    })
+                    .collect();
+                primary_image = Some(PrimaryImage::new(w, h, &pixels));
+            }
+            workloads.push(WorkloadResult {
+                workload: wl.workload.name().to_string(),
+                queries: wl.rays.len(),
+                any_hit,
+                point_query: false,
+                mqueries_per_s: mrays,
+                speedup_vs_reference: None,
+                counters_per_query: has_counters
+                    .then(|| CountersPerQuery::from_total(&counters, wl.rays.len())),
+                counters_total: has_counters.then_some(counters),
+                agreement,
+            });
+        }
+        for pw in self.point_workloads.iter().filter(|w| !w.points.is_empty()) {
+            workloads.push(self.measure_points(accel, pw, opts));
+        }
+        let memory = accel.memory();
+        Ok(ResultEntry {
+            scene: s.name.clone(),
+            triangles: triangle_counts(s),
+            structure: entry.name.to_string(),
+            params: built.params.clone(),
+            build,
+            build_ratio_to_reference: None,
+            memory_bytes: memory.total(),
+            memory,
+            build_stats: accel.build_stats(),
+            workloads,
+            primary_image,
+        })
+    }
+
+    /// One structure on one closest-point workload: timed like rays (warm-up, median of
+    /// `trace_runs` passes on the run's threads), then the counted pass, then the check
+    /// against the reference. Not dumped: `--dump-hits` covers ray workloads only.
+    fn measure_points(
+        &self,
+        accel: &dyn Accel,
+        pw: &PreparedPoints,
+        opts: &RunOptions,
+    ) -> WorkloadResult {
+        let (answers, throughput) =
+            time_point_queries(accel, &pw.points, pw.radius, opts.threads, opts.trace_runs);
+        let (counted, counters) = count_point_pass(accel, &pw.points, pw.radius);
+        let mesh = &self.scene.scene.mesh;
+        let mut agreement = check_points(
+            mesh,
+            &pw.points,
+            pw.radius,
+            &answers,
+            &pw.reference,
+            &self.reference_name,
+        );
+        agreement.counted_path_differs = counted_point_differences(&answers, &counted);
+        let has_counters = accel.has_counters();
+        WorkloadResult {
+            workload: pw.workload.name().to_string(),
+            queries: pw.points.len(),
+            any_hit: false,
+            point_query: true,
+            mqueries_per_s: throughput,
+            speedup_vs_reference: None,
+            counters_per_query: has_counters
+                .then(|| CountersPerQuery::from_total(&counters, pw.points.len())),
+            counters_total: has_counters.then_some(counters),
+            agreement,
+        }
+    }
+}
+
+/// Ratios to the reference measured in the same run: build time and throughput per workload.
+fn fill_ratios(report: &mut Report) {
+    let reference = report.run.reference.clone();
+    let refs: Vec<ResultEntry> = report
+        .results
+        .iter()
+        .filter(|r| r.structure == reference)
+        .cloned()
+        .collect();
+    for r in &mut report.results {
+        let Some(base) = refs.iter().find(|b| b.scene == r.scene) else {
+            continue;
+        };
+        r.build_ratio_to_reference =
+            (base.build.median_ms > 0.0).then(|| r.build.median_ms / base.build.median_ms);
+        for w in &mut r.workloads {
+            let base_w = base.workloads.iter().find(|b| b.workload == w.workload);
+            w.speedup_vs_reference = base_w
+                .filter(|b| b.mqueries_per_s.median > 0.0)
+                .map(|b| w.mqueries_per_s.median / b.mqueries_per_s.median);
+        }
+    }
+}

@@ -1,0 +1,214 @@
+//! `report.json`: the data model, written atomically and read back with serde.
+//!
+//! Every float in the report is finite: a miss is an explicit `null` hit, never `t = inf`
+//! (serde_json writes non-finite floats as `null` and then cannot read them back), and exact
+//! ray and hit values are carried as hex bit patterns so a disputed ray can be replayed.
+
+use super::agreement::Agreement;
+use super::{Header, read_report, write_json_atomic};
+use raybench_accel::classify::Tolerance;
+use raybench_accel::{BuildStats, Counters, Memory};
+use raybench_geom::RemovedTriangles;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Bumped whenever a field changes meaning, is renamed or disappears.
+pub const SCHEMA_VERSION: u32 = 2;
+
+/// The oldest schema version still read (version 1 through the old names of the fields of
+/// [`WorkloadResult`] and [`WorkloadRecord`]).
+pub const OLDEST_READABLE: u32 = 1;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Report {
+    #[serde(flatten)]
+    pub header: Header,
+    pub run: RunSettings,
+    pub scenes: Vec<SceneRecord>,
+    pub results: Vec<ResultEntry>,
+    /// Things the reader should know: skipped structures, absent optional scenes, …
+    pub notes: Vec<String>,
+    /// Scenes or structures that failed (the rest of the run went on).
+    pub errors: Vec<String>,
+}
+
+/// The knobs of the run itself.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunSettings {
+    pub suite: Option<String>,
+    pub seed: u64,
+    pub rays: usize,
+    /// Query points per closest-point workload (0 in reports older than point workloads).
+    #[serde(default)]
+    pub points: usize,
+    pub threads: usize,
+    pub reference: String,
+    pub build_runs: usize,
+    pub trace_runs: usize,
+    pub tolerance: Tolerance,
+    pub structures: Vec<String>,
+    pub workloads: Vec<String>,
+    /// Recursion control of the `whitted` workload.
+    pub whitted: raybench_scenes::WhittedParams,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SceneRecord {
+    pub name: String,
+    pub source: serde_json::Value,
+    pub triangles: TriangleCounts,
+    pub load_ms: f64,
+    pub loader_notes: Vec<String>,
+    pub view: serde_json::Value,
+    /// Workloads as generated for this scene (same rays for every structure).
+    pub workloads: Vec<WorkloadRecord>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct WorkloadRecord {
+    pub workload: String,
+    /// Rays, or query points for a point workload.
+    #[serde(alias = "rays")]
+    pub queries: usize,
+    pub any_hit: bool,
+    /// A closest-point workload (`points-near`, `points-volume`), asked with an infinite radius.
+    #[serde(default)]
+    pub point_query: bool,
+    /// Primary image size, where the workload is an image.
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct TriangleCounts {
+    /// Triangles the loader or generator produced.
+    pub loaded: u64,
+    /// Removed before any structure saw them (what Embree would silently ignore).
+    pub removed: u64,
+    pub removed_by_reason: RemovedTriangles,
+    /// Triangles every structure traces (`loaded - removed`).
+    pub traced: u64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ResultEntry {
+    pub scene: String,
+    pub triangles: TriangleCounts,
+    pub structure: String,
+    pub params: serde_json::Value,
+    pub build: Timing,
+    /// Build median divided by the reference's build median in this run.
+    pub build_ratio_to_reference: Option<f64>,
+    pub memory_bytes: u64,
+    pub memory: Memory,
+    pub build_stats: BuildStats,
+    pub workloads: Vec<WorkloadResult>,
+    /// Per-pixel pictures of the primary workload (absent when it was not run).
+    #[serde(default)]
+    pub primary_image: Option<crate::pipeline::images::PrimaryImage>,
+}
+
+/// Wall-clock build time over `runs` builds after one warm-up build.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct Timing {
+    pub median_ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+    pub runs: usize,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct Throughput {
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+    pub runs: usize,
+}
+
+/// One structure on one workload. A query is a ray in a ray workload and a point in a
+/// closest-point workload (`point_query`): there `prim_tests` counts point–triangle distance
+/// tests and `both_miss` means neither side found a triangle. Reports of schema version 1 named
+/// four fields after rays (`rays`, `mrays_per_s`, `counters_per_ray`, `validation`); they are
+/// read under those names too.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct WorkloadResult {
+    pub workload: String,
+    /// Rays, or query points for a point workload.
+    #[serde(alias = "rays")]
+    pub queries: usize,
+    pub any_hit: bool,
+    /// True for a closest-point workload (absent in older reports: false).
+    #[serde(default)]
+    pub point_query: bool,
+    /// Millions of queries per second: rays, or closest-point queries when `point_query`.
+    #[serde(alias = "mrays_per_s")]
+    pub mqueries_per_s: Throughput,
+    /// Median throughput divided by the reference's in this run (> 1: faster than reference).
+    pub speedup_vs_reference: Option<f64>,
+    /// `None` for structures that cannot count their work (Embree).
+    #[serde(alias = "counters_per_ray")]
+    pub counters_per_query: Option<CountersPerQuery>,
+    pub counters_total: Option<Counters>,
+    #[serde(alias = "validation")]
+    pub agreement: Agreement,
+}
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct CountersPerQuery {
+    pub nodes: f64,
+    pub leaves: f64,
+    pub prim_tests: f64,
+    pub cells: f64,
+    pub mailbox_skips: f64,
+}
+
+impl CountersPerQuery {
+    pub fn from_total(c: &Counters, queries: usize) -> CountersPerQuery {
+        let n = queries.max(1) as f64;
+        CountersPerQuery {
+            nodes: c.nodes as f64 / n,
+            leaves: c.leaves as f64 / n,
+            prim_tests: c.prim_tests as f64 / n,
+            cells: c.cells as f64 / n,
+            mailbox_skips: c.mailbox_skips as f64 / n,
+        }
+    }
+}
+
+impl Report {
+    /// Writes `dir/report.json` atomically (see [`crate::atomic`]): readers never see a
+    /// half-written report, and a failed write leaves no temporary file.
+    pub fn write_atomic(&self, dir: &Path) -> anyhow::Result<std::path::PathBuf> {
+        write_json_atomic(dir, "report.json", self)
+    }
+
+    pub fn read(path: &Path) -> anyhow::Result<Report> {
+        read_report(path, OLDEST_READABLE..=SCHEMA_VERSION)
+    }
+
+    /// Total mismatches over every structure, scene and workload.
+    pub fn mismatches(&self) -> u64 {
+        self.results
+            .iter()
+            .flat_map(|r| &r.workloads)
+            .map(|w| w.agreement.counts.mismatch + w.agreement.counted_path_differs)
+            .sum()
+    }
+}
+
+/// True for a closest-point workload's name (`points-near`, `points-volume`).
+pub fn is_point_workload(workload: &str) -> bool {
+    workload
+        .parse::<raybench_scenes::Workload>()
+        .is_ok_and(|w| w.is_point_query())
+}
+
+/// What a workload's `mqueries_per_s` counts: "Mqueries/s" for closest-point workloads,
+/// "Mrays/s" for ray workloads.
+pub fn throughput_unit(workload: &str) -> &'static str {
+    if is_point_workload(workload) {
+        "Mqueries/s"
+    } else {
+        "Mrays/s"
+    }
+}
