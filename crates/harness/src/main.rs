@@ -21,7 +21,7 @@ struct Cli {
 enum Command {
     /// Scenes, structures, workloads and suites raybench knows.
     List,
-    /// Build, time, count and validate; write DIR/report.json.
+    /// Build, time, count and check every answer; write DIR/report.json.
     Run(cli::run::RunArgs),
     /// Look at scenes: list generators and views, export as OBJ, render a preview PNG.
     #[command(subcommand)]

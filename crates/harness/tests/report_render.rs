@@ -55,7 +55,7 @@ fn every_chart_type_is_drawn() {
             "break-even-sphere-triangles-2000.svg",
             "build + trace K rays",
         ),
-        ("validation.svg", "Rays per validation class"),
+        ("agreement.svg", "Rays per agreement class"),
     ] {
         let svg = std::fs::read_to_string(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(svg.starts_with("<svg"), "{file} is not an SVG");

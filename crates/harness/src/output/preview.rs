@@ -55,9 +55,10 @@ pub fn camera_rays(view: &View, bounds: &Aabb, width: u32, height: u32) -> Vec<R
     }
 }
 
-/// The construction of workload.rs's `CameraFrame` for any `width × height`.
+/// The construction of the primary workload's `CameraFrame` (raybench-scenes,
+/// `workload/primary.rs`) for any `width × height`.
 fn local_camera_rays(view: &View, bounds: &Aabb, width: u32, height: u32) -> Vec<Ray> {
-    // The same steps as workload.rs `CameraFrame`, in the same order, so both agree bit for
+    // The same steps as the primary workload's `CameraFrame`, in the same order, so both agree bit for
     // bit (tested): unusable views fall back to the default view of the bounds.
     let view = if view.is_usable() {
         *view

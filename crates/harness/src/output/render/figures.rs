@@ -173,15 +173,15 @@ pub(super) fn all_charts(report: &Report) -> Result<Vec<(String, String, String)
     let agreement = agreement_chart(report);
     if agreement.has_data() {
         out.push((
-            "validation.svg".into(),
-            format!("Validation classes per structure against {reference}, all scenes and workloads (log scale)"),
+            "agreement.svg".into(),
+            format!("Agreement classes per structure against {reference}, all scenes and workloads (log scale)"),
             charts::bars_svg(&agreement, W, H)?,
         ));
     }
     Ok(out)
 }
 
-/// How many rays of a validation class.
+/// How many rays of an agreement class.
 type ClassCount = fn(&raybench_accel::classify::VerdictCounts) -> u64;
 
 fn agreement_chart(report: &Report) -> Bars {
@@ -215,7 +215,7 @@ fn agreement_chart(report: &Report) -> Bars {
         })
         .collect();
     Bars {
-        title: "Rays per validation class".into(),
+        title: "Rays per agreement class".into(),
         y_desc: "rays".into(),
         groups: structures,
         series,

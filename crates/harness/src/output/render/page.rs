@@ -46,7 +46,7 @@ pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictu
     let mismatches = report.mismatches();
     let _ = writeln!(
         s,
-        "<p class=\"{}\">{} mismatches in {} validated rays.</p>",
+        "<p class=\"{}\">{} mismatches in {} checked rays.</p>",
         if mismatches > 0 { "bad" } else { "note" },
         mismatches,
         report
@@ -143,7 +143,7 @@ fn ratio(r: Option<f64>) -> String {
 
 fn agreement_table(s: &mut String, report: &Report) {
     s.push_str(
-        "<h2>Validation</h2>\n<table><tr><th class=\"l\">structure</th><th>rays</th><th>both miss</th>\
+        "<h2>Agreement</h2>\n<table><tr><th class=\"l\">structure</th><th>rays</th><th>both miss</th>\
          <th>exact</th><th>within tolerance</th><th>tie</th><th>boundary</th><th>edge ambiguous</th>\
          <th>mismatch</th><th>counted path differs</th></tr>\n",
     );
