@@ -105,8 +105,10 @@ impl Ray {
     }
 
     /// Checks the ray against the rules Debian's Embree enforces by aborting the process
-    /// (`assert(ray.valid())`, `assert(tnear >= 0)`), plus a non-zero direction, which raybench
-    /// treats as invalid input although Embree merely misses.
+    /// (`assert(ray.valid())`, `assert(tnear >= 0)`), plus a direction that stays non-zero
+    /// under flush-to-zero (a component that is not zero or subnormal), which raybench treats as
+    /// invalid input although Embree merely misses: the same ray must mean the same thing with
+    /// and without `--ftz-daz`.
     pub fn check(&self) -> Result<(), RayError> {
         let comps = [
             ("origin.x", self.origin.x),
@@ -136,6 +138,14 @@ impl Ray {
         }
         if self.dir == Vec3::ZERO {
             return Err(RayError::ZeroDirection);
+        }
+        if self
+            .dir
+            .to_array()
+            .iter()
+            .all(|c| *c == 0.0 || c.is_subnormal())
+        {
+            return Err(RayError::SubnormalDirection);
         }
         Ok(())
     }
@@ -167,6 +177,7 @@ pub enum RayError {
     TooLarge(&'static str, f32),
     NegativeTMin(f32),
     ZeroDirection,
+    SubnormalDirection,
 }
 
 impl fmt::Display for RayError {
@@ -181,6 +192,11 @@ impl fmt::Display for RayError {
             }
             RayError::NegativeTMin(t) => write!(f, "t_min = {t:e} is negative"),
             RayError::ZeroDirection => write!(f, "direction is (0, 0, 0)"),
+            RayError::SubnormalDirection => write!(
+                f,
+                "direction has no component above the subnormal range, so flush-to-zero makes \
+                 it (0, 0, 0)"
+            ),
         }
     }
 }
@@ -223,6 +239,15 @@ mod tests {
             Ray::infinite(Vec3::new(1e18, 0.0, 0.0), Vec3::X).check(),
             Ok(())
         );
+        // Subnormal in every component is zero under flush-to-zero; one normal component is
+        // enough.
+        let tiny = Vec3::new(1e-40, -0.0, f32::from_bits(1));
+        assert_eq!(
+            Ray::infinite(Vec3::ZERO, tiny).check(),
+            Err(RayError::SubnormalDirection)
+        );
+        let small = Vec3::new(f32::MIN_POSITIVE, 1e-40, 0.0);
+        assert_eq!(Ray::infinite(Vec3::ZERO, small).check(), Ok(()));
     }
 
     #[test]

@@ -1,12 +1,45 @@
-//! Files that appear whole or not at all: every report, dump and chart is written to a
-//! temporary file beside its target, flushed to disk, then renamed over the target. A failure
-//! at any step removes the temporary file, so a failed or interrupted write leaves neither a
-//! half-written file nor a stray temporary one (only a kill between `create` and `rename` can
-//! leave a `.<name>.<pid>.tmp` behind, never a truncated target).
+//! Files that appear whole or not at all: every file raybench writes (reports, dumps, charts,
+//! pictures, exported scenes) is written to a temporary file beside its target, flushed to
+//! disk, then renamed over the target. A failure at any step removes the temporary file, and
+//! so does an interrupt: the temporary files being written are listed while they exist, and
+//! the Ctrl-C handler ([`crate::interrupt`]) removes them before the process exits. Only a
+//! `kill -9` between `create` and `rename` can leave a `.<name>.<pid>.tmp` behind; a target is
+//! never truncated.
 
 use anyhow::{Context, Result};
-use std::io::Write;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// The temporary files being written now.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// A temporary file listed in [`LIVE`] from creation until it is renamed or removed.
+struct Temporary(PathBuf);
+
+impl Temporary {
+    fn new(path: PathBuf) -> Temporary {
+        live().push(path.clone());
+        Temporary(path)
+    }
+}
+
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        live().retain(|p| p != &self.0);
+    }
+}
+
+/// Removes every temporary file being written (the interrupt handler's clean-up).
+pub fn remove_temporaries() {
+    for p in live().drain(..) {
+        let _ = std::fs::remove_file(&p);
+    }
+}
 
 /// The temporary name used for `path`: hidden, and unique per process.
 fn temp_path(path: &Path) -> PathBuf {
@@ -19,31 +52,36 @@ fn temp_path(path: &Path) -> PathBuf {
 
 /// Writes `bytes` to `path` atomically (see the module documentation).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = temp_path(path);
-    let result = (|| -> Result<()> {
-        let mut f =
-            std::fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
-        f.write_all(bytes)
-            .and_then(|_| f.sync_all())
-            .with_context(|| format!("writing {}", tmp.display()))?;
-        std::fs::rename(&tmp, path)
-            .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    write_atomic_with(path, |w| w.write_all(bytes))
 }
 
-/// Creates `dir` if needed and proves a file can be created in it, before any work is done:
-/// an unwritable `--out` fails in a second, not after an hour of measuring.
-pub fn ensure_writable_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("output directory {} cannot be created", dir.display()))?;
-    let probe = temp_path(&dir.join("write-probe"));
-    std::fs::File::create(&probe)
-        .with_context(|| format!("output directory {} is not writable", dir.display()))?;
-    std::fs::remove_file(&probe).with_context(|| format!("removing {}", probe.display()))
+/// Writes what `fill` writes to `path` atomically, streaming it (see the module
+/// documentation).
+pub fn write_atomic_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<()> {
+    let tmp = Temporary::new(temp_path(path));
+    let result = (|| -> Result<()> {
+        let f = std::fs::File::create(&tmp.0)
+            .with_context(|| format!("creating {}", tmp.0.display()))?;
+        let mut w = BufWriter::new(f);
+        fill(&mut w)
+            .and_then(|()| w.flush())
+            .with_context(|| format!("writing {}", tmp.0.display()))?;
+        let f = w
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .with_context(|| format!("writing {}", tmp.0.display()))?;
+        f.sync_all()
+            .with_context(|| format!("writing {}", tmp.0.display()))?;
+        std::fs::rename(&tmp.0, path)
+            .with_context(|| format!("renaming {} to {}", tmp.0.display(), path.display()))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp.0);
+    }
+    result
 }
 
 #[cfg(test)]
@@ -86,18 +124,6 @@ mod tests {
         let err = write_atomic(&target, b"data").unwrap_err();
         assert!(format!("{err:#}").contains("taken"), "{err:#}");
         assert_eq!(entries(&d), ["taken"]);
-        std::fs::remove_dir_all(d).unwrap();
-    }
-
-    #[test]
-    fn a_file_where_the_directory_should_be_is_not_writable() {
-        let d = scratch("notdir");
-        let file = d.join("plain-file");
-        std::fs::write(&file, b"x").unwrap();
-        let err = ensure_writable_dir(&file.join("sub")).unwrap_err();
-        assert!(format!("{err:#}").contains("plain-file"), "{err:#}");
-        ensure_writable_dir(&d.join("fresh")).unwrap();
-        assert_eq!(entries(&d.join("fresh")), Vec::<String>::new());
         std::fs::remove_dir_all(d).unwrap();
     }
 }

@@ -10,6 +10,8 @@
 pub mod atomic;
 pub mod cli;
 pub mod env;
+pub mod interrupt;
+pub mod outdir;
 pub mod output;
 pub mod pipeline;
 pub mod registry;

@@ -15,6 +15,9 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The largest file raybench reads (scenes, suites, reports), e.g. 8G; default 4G.
+    #[arg(long, global = true, value_parser = cli::bounds::byte_size)]
+    max_input_size: Option<u64>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -49,6 +52,7 @@ enum Command {
 
 fn main() -> ExitCode {
     one_line_panics();
+    raybench_harness::interrupt::install();
     // Usage errors exit 1 like every other error: 2 means "mismatch" to scripts.
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -61,6 +65,9 @@ fn main() -> ExitCode {
             };
         }
     };
+    if let Some(limit) = cli.max_input_size {
+        raybench_scenes::input::set_max_input_bytes(limit);
+    }
     let outcome = match cli.command {
         Command::List => cli::list::run(),
         Command::Run(args) => cli::run::run(args),
@@ -84,7 +91,10 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("raybench: error: {e:#}");
+            eprintln!(
+                "raybench: error: {}",
+                raybench_scenes::printable(&format!("{e:#}"))
+            );
             ExitCode::from(1)
         }
     }

@@ -1,10 +1,8 @@
 //! The `raybench` binary as a user runs it.
 
-use std::process::Command;
+mod common;
 
-fn raybench() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_raybench"))
-}
+use common::{assert_clear_error, files_below, invoke, raybench, scratch};
 
 #[test]
 fn list_names_structures_workloads_and_suites() {
@@ -165,61 +163,6 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
         );
     }
     std::fs::remove_dir_all(dir).unwrap();
-}
-
-/// Exit code, stdout and stderr of one invocation.
-fn invoke(args: &[&str]) -> (i32, String, String) {
-    let out = raybench().args(args).output().unwrap();
-    (
-        out.status.code().expect("exited, not killed by a signal"),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-/// A fresh, empty scratch directory for one test.
-fn scratch(tag: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("raybench-cli-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Every file below `dir`, relative, sorted.
-fn files_below(dir: &std::path::Path) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push(p.strip_prefix(dir).unwrap().display().to_string());
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
-/// The error is on the first line of stderr and names `bad`; no panic, no backtrace.
-fn assert_clear_error(args: &[&str], bad: &str) {
-    let (code, _, stderr) = invoke(args);
-    assert_eq!(code, 1, "{args:?}: {stderr}");
-    let first = stderr.lines().next().unwrap_or_default();
-    assert!(
-        first.contains(bad),
-        "{args:?}: the first line does not name {bad}: {stderr}"
-    );
-    assert!(
-        first.starts_with("raybench: error:") || first.starts_with("error:"),
-        "{stderr}"
-    );
-    assert!(
-        !stderr.contains("panicked") && !stderr.contains("backtrace"),
-        "{stderr}"
-    );
 }
 
 #[test]

@@ -117,6 +117,37 @@ fn a_missing_structure_is_a_regression() {
     );
 }
 
+/// The new report lists one scene × structure twice, its first copy with a mismatch: keying
+/// it would keep the clean last copy, so the duplicate itself is the regression.
+#[test]
+fn a_report_with_duplicate_entries_is_refused_naming_them() {
+    let mut new = base().clone();
+    let mut bad = bvh(&mut new).clone();
+    bad.workloads[0].agreement.counts.mismatch = 7;
+    let at = new
+        .results
+        .iter()
+        .position(|r| r.structure == "bvh-binned")
+        .unwrap();
+    new.results.insert(at, bad);
+    let r = regressions(&new, &CompareOptions::default());
+    assert!(
+        r.iter()
+            .any(|x| x
+                .contains("the new report lists soup:triangles=300 / bvh-binned more than once")),
+        "{r:?}"
+    );
+    let mut twice = base().clone();
+    let w = bvh(&mut twice).workloads[0].clone();
+    bvh(&mut twice).workloads.push(w);
+    let r = regressions(&twice, &CompareOptions::default());
+    assert!(
+        r.iter()
+            .any(|x| x.contains("soup:triangles=300 / bvh-binned / primary more than once")),
+        "{r:?}"
+    );
+}
+
 #[test]
 fn different_settings_and_machines_are_flagged() {
     let mut new = base().clone();

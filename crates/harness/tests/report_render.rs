@@ -232,3 +232,28 @@ fn headless_chromium_renders_the_page_and_a_chart() {
         "the chart screenshot is (nearly) blank"
     );
 }
+
+/// Any finite value a report may hold is drawn: speedups of 5e-324 and 1.7e308, build times of
+/// 1e-300 ms and throughputs at both ends of f64 once hung the chart axes (an infinite log
+/// axis has no last tick). The report goes through JSON first, as `raybench report` reads it.
+#[test]
+fn extreme_finite_values_are_drawn() {
+    let mut extreme = report().clone();
+    let ends = [5e-324, 1.7e308, 1e-300, f64::MAX, f64::MIN_POSITIVE];
+    for (i, r) in extreme.results.iter_mut().enumerate() {
+        let v = ends[i % ends.len()];
+        r.build.median_ms = v;
+        r.build_ratio_to_reference = Some(ends[(i + 1) % ends.len()]);
+        r.memory_bytes = u64::MAX;
+        for (k, w) in r.workloads.iter_mut().enumerate() {
+            w.mqueries_per_s.median = ends[(i + k) % ends.len()];
+            w.speedup_vs_reference = Some(ends[(i + k + 2) % ends.len()]);
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("raybench-extreme-{}", std::process::id()));
+    let path = extreme.write_atomic(&dir).unwrap();
+    let back = Report::read(&path).unwrap();
+    let drawn = render(&back, &dir).unwrap();
+    assert!(drawn.index.exists() && !drawn.charts.is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,3 +1,4 @@
+use crate::input::InputError;
 use raybench_geom::MeshError;
 use std::path::PathBuf;
 
@@ -7,15 +8,17 @@ use std::path::PathBuf;
 /// the problem, with a line number where one is known, so it can be printed as it is.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// The file could not be opened or read (missing, unreadable, a directory on some systems).
+    /// The file could not be opened or read (missing, not a regular file, too large,
+    /// unreadable): see [`crate::input`].
+    #[error(transparent)]
+    Input(#[from] InputError),
+
+    /// A directory could not be listed.
     #[error("{}: cannot read: {source}", .path.display())]
     Io {
         path: PathBuf,
         source: std::io::Error,
     },
-
-    #[error("{}: is a directory, not a file", .path.display())]
-    IsDirectory { path: PathBuf },
 
     /// Bytes that are not UTF-8; tobj would stop at the line with a bare "read error". `hint`
     /// names a likely cause when the bytes show one (UTF-16, binary data), else it is empty.

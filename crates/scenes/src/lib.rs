@@ -13,6 +13,7 @@
 
 mod error;
 mod generate;
+pub mod input;
 mod material;
 mod obj;
 pub mod points;
@@ -25,13 +26,14 @@ mod workload;
 
 pub use error::SceneError;
 pub use generate::{
-    GeneratorInfo, Kind, MAX_TRIANGLES, ParamInfo, check_spec, generate, generators,
+    GeneratorInfo, Kind, MAX_TRIANGLES, ParamInfo, check_spec, generate, generators, view_names,
+    view_probe_spec,
 };
 pub use material::Material;
 pub use obj::export::{in_file_order, write_obj};
 pub use obj::{load_obj, load_obj_bytes};
 pub use recipe::{RayRecipe, TraceFn};
-pub use request::SceneRequest;
+pub use request::{SceneRequest, printable};
 pub use suite::{Suite, SuiteScene, list_suites, load_suite, suites_dir};
 pub use view::{Camera, View};
 pub use workload::{

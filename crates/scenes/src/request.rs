@@ -5,6 +5,7 @@
 //! optional. Requests are checked before any work ([`SceneRequest::check`]) and loaded one at
 //! a time ([`SceneRequest::load`]), so a run holds one scene in memory at once.
 
+use crate::input::{check_input, is_absent};
 use crate::{Scene, SceneError, Suite, SuiteScene, check_spec, is_obj_path, load_obj, resolve};
 use std::path::{Path, PathBuf};
 
@@ -46,27 +47,32 @@ impl SceneRequest {
 
     /// The name a report gives the scene: the spec as written (`teapot-in-stadium:view=
     /// stadium`), or an OBJ file's name (`teapot.obj`), so a generated teapot and the teapot
-    /// file, or two views of one generator, never share a name.
+    /// file, or two views of one generator, never share a name. Control characters are
+    /// escaped ([`printable`]): the name is printed in tables and pages.
     pub fn report_name(&self) -> String {
         let file_name = |p: &Path| p.file_name().map(|n| n.to_string_lossy().into_owned());
-        match self {
+        let name = match self {
             SceneRequest::Spec(s) if is_obj_path(s) => {
                 file_name(Path::new(s)).unwrap_or_else(|| s.clone())
             }
             SceneRequest::Spec(s) => s.trim().to_string(),
             SceneRequest::File { path, .. } => file_name(path).unwrap_or_else(|| self.label()),
-        }
+        };
+        printable(&name).into_owned()
     }
 
-    /// What can be checked without loading: a generator spec names a generator and valid
-    /// parameters; an OBJ file that is not optional exists.
+    /// What can be checked without loading: a generator spec names a generator, valid
+    /// parameters and a view it has; an OBJ file is a regular file within the size limit
+    /// (an optional one only when it is there).
     pub fn check(&self) -> Result<(), SceneError> {
-        match self {
-            SceneRequest::Spec(spec) if is_obj_path(spec) => exists(Path::new(spec)),
-            SceneRequest::Spec(spec) => check_spec(spec),
-            SceneRequest::File { path, optional } if !optional => exists(path),
-            SceneRequest::File { .. } => Ok(()),
-        }
+        let file = match self {
+            SceneRequest::Spec(spec) if is_obj_path(spec) => Path::new(spec),
+            SceneRequest::Spec(spec) => return check_spec(spec),
+            SceneRequest::File { path, optional } if *optional && is_absent(path) => return Ok(()),
+            SceneRequest::File { path, .. } => path,
+        };
+        check_input(file)?;
+        Ok(())
     }
 
     /// The scene, or `None` for an optional file that is absent ("not found", including a
@@ -84,12 +90,19 @@ impl SceneRequest {
     }
 }
 
-fn exists(path: &Path) -> Result<(), SceneError> {
-    std::fs::metadata(path)
-        .map(|_| ())
-        .map_err(|e| SceneError::io(path, e))
-}
-
-fn is_absent(path: &Path) -> bool {
-    matches!(std::fs::metadata(path), Err(e) if e.kind() == std::io::ErrorKind::NotFound)
+/// `text` safe to print on a terminal and in reports: control characters (an ANSI escape in a
+/// file name would clear the screen) are written as `\u{1b}`, everything else as it is.
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if c.is_control() && c != '\n' {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
 }

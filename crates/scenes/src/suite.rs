@@ -41,8 +41,8 @@ pub enum SuiteScene {
 /// Reads and checks a manifest: valid JSON of the right shape, no unknown fields, and at least
 /// one scene, structure and workload, and a non-zero ray count.
 pub fn load_suite(path: &Path) -> Result<Suite, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::io(path, e))?;
-    let suite: Suite = serde_json::from_str(&text).map_err(|source| SceneError::SuiteJson {
+    let bytes = crate::input::read_input(path)?;
+    let suite: Suite = serde_json::from_slice(&bytes).map_err(|source| SceneError::SuiteJson {
         path: path.to_owned(),
         source,
     })?;

@@ -1,6 +1,7 @@
 mod common;
 
 use common::Fixtures;
+use raybench_scenes::input::InputError;
 use raybench_scenes::{
     SceneError, Suite, SuiteScene, Workload, generate, list_suites, load_suite, suites_dir,
 };
@@ -189,7 +190,10 @@ fn absent_optional_file_is_a_note_but_broken_or_required_files_are_errors() {
         broken.contains("broken.obj: line 2: vertex index 2 is out of range"),
         "{broken}"
     );
-    assert!(matches!(requests[3].load(0), Err(SceneError::Io { .. })));
+    assert!(matches!(
+        requests[3].load(0),
+        Err(SceneError::Input(InputError::Missing { .. }))
+    ));
     let missing = requests[3].check().unwrap_err().to_string();
     assert!(missing.contains("missing.obj"), "{missing}");
 }

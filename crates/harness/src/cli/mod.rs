@@ -3,6 +3,7 @@
 //! flags and their resolution), checks of every value and output directory before any work
 //! starts, and the exit status. Every bad value is one error line naming it, exit status 1.
 
+pub mod bounds;
 pub mod compare;
 pub mod list;
 pub mod replay;
@@ -13,13 +14,13 @@ pub mod scene;
 pub mod verify;
 pub mod watertight;
 
-use crate::atomic::ensure_writable_dir;
+use crate::outdir::{self, OutDir, Output};
 use crate::pipeline::scenes::check_requests;
 use crate::registry;
 use anyhow::{Context, Result};
 use clap::Args;
 use raybench_scenes::{SceneRequest, Workload};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 
 /// Query points per closest-point workload when neither `--points` nor the suite say: a point
@@ -66,8 +67,8 @@ pub struct Selection {
     /// Query points per closest-point workload (points-near, points-volume).
     #[arg(long, value_parser = at_least_one)]
     pub points: Option<usize>,
-    /// Worker threads for builds and traces (Embree gets threads=N).
-    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
+    /// Worker threads for builds and traces (Embree gets threads=N); at most 8 per core.
+    #[arg(long, default_value_t = 1, value_parser = bounds::threads)]
     pub threads: usize,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -140,6 +141,20 @@ impl Selection {
             .points
             .or(suite.as_ref().and_then(|s| s.points))
             .unwrap_or(defaults.points);
+        let source = |flag: &str| match (&self.suite, suite.is_some()) {
+            (Some(name), true) => format!("{flag} (with suite '{name}')"),
+            _ => flag.to_string(),
+        };
+        no_duplicates(&source("--scenes"), requests.iter().map(|r| r.label()))?;
+        no_duplicates(&source("--structures"), structures.iter().cloned())?;
+        no_duplicates(
+            &source("--workloads"),
+            workloads.iter().map(|w| w.name().to_string()),
+        )?;
+        let ray_workloads = workloads.iter().filter(|w| !w.is_point_query()).count();
+        let whitted = workloads.contains(&Workload::Whitted);
+        bounds::check_rays(rays, ray_workloads, whitted)?;
+        bounds::check_points(points, workloads.len() - ray_workloads)?;
         Ok(Resolved {
             requests,
             structures,
@@ -148,6 +163,20 @@ impl Selection {
             points,
         })
     }
+}
+
+/// Refuses a list that names something twice: a scene, structure or workload measured twice
+/// in one run would be two entries under one name, which reports and `compare` cannot tell
+/// apart.
+pub(crate) fn no_duplicates(flag: &str, names: impl Iterator<Item = String>) -> Result<()> {
+    let mut seen = std::collections::HashSet::new();
+    for name in names {
+        anyhow::ensure!(
+            seen.insert(name.clone()),
+            "{flag} names `{name}` twice; each may appear once"
+        );
+    }
+    Ok(())
 }
 
 /// Every registered structure's name.
@@ -198,20 +227,35 @@ pub fn pick<T>(
     }
 }
 
-/// `reports/<date>-<revision>`: where reports go unless `--out` says otherwise.
-pub fn default_out_dir() -> PathBuf {
-    let date = &crate::env::utc_timestamp()[..10];
-    let rev: String = crate::env::git_revision().chars().take(10).collect();
-    PathBuf::from("reports").join(format!("{date}-{rev}"))
+/// The output directories of a command, claimed (locked, checked, proven writable) before any
+/// work; dropping it releases them.
+#[derive(Debug)]
+pub struct Claimed {
+    pub out: OutDir,
+    pub dumps: Option<OutDir>,
 }
 
-/// Proves both output directories writable (creating them) before any work, the dump directory
-/// first so that a bad `--dump-hits` leaves not even an empty `--out` behind.
-pub fn check_outputs(out: &Path, dump_hits: Option<&Path>) -> Result<()> {
-    if let Some(d) = dump_hits {
-        ensure_writable_dir(d).context("--dump-hits")?;
-    }
-    ensure_writable_dir(out).context("--out")
+/// Claims `--out` (or a new `reports/<date>-<revision>[-N]`) for `outputs`, and `--dump-hits`
+/// when given, the dump directory first so that a bad `--dump-hits` leaves not even an empty
+/// `--out` behind. `force` replaces the outputs of an earlier command (see [`OutDir::claim`]).
+pub fn claim_outputs(
+    out: Option<&Path>,
+    outputs: &[Output],
+    dump_hits: Option<&Path>,
+    force: bool,
+) -> Result<Claimed> {
+    let dumps = dump_hits
+        .map(|d| OutDir::claim(d, outdir::DUMPS, force).context("--dump-hits"))
+        .transpose()?;
+    let out = match out {
+        Some(dir) => OutDir::claim(dir, outputs, force).context("--out")?,
+        None => {
+            let date = &crate::env::utc_timestamp()[..10];
+            let rev: String = crate::env::git_revision().chars().take(10).collect();
+            OutDir::claim_new(Path::new("reports"), &format!("{date}-{rev}"), outputs)?
+        }
+    };
+    Ok(Claimed { out, dumps })
 }
 
 /// 2 on any mismatch (the answers are wrong somewhere), else 1 on errors, else 0.

@@ -1,40 +1,68 @@
 //! `raybench report`: draw a report again from its JSON alone (charts, pictures, index.html).
 
+use crate::outdir::{self, OutDir};
 use crate::output::render::{Rendered, render};
 use crate::report::run::Report;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Args, Debug)]
 pub struct ReportArgs {
     /// The report.json to draw.
     report: PathBuf,
-    /// Output directory (default: the report's own directory).
+    /// Output directory (default: the report's own directory, whose earlier drawing is
+    /// replaced).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Draw into an --out that holds another drawing, replacing it.
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn run(args: ReportArgs) -> Result<ExitCode> {
     let report = Report::read(&args.report)?;
-    let dir = match args.out {
-        Some(d) => d,
-        None => args
-            .report
-            .parent()
-            .map(|p| p.to_path_buf())
-            .unwrap_or_else(|| PathBuf::from(".")),
-    };
-    print_rendered(&render(&report, &dir)?);
+    let own_dir = args
+        .report
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+    let claimed = match &args.out {
+        // Redrawing a report where it lives replaces its own earlier drawing.
+        None => OutDir::claim(&own_dir, outdir::DRAWING, true),
+        Some(dir) if same_dir(dir, &own_dir) => OutDir::claim(dir, outdir::DRAWING, true),
+        // Elsewhere, a drawing already there belongs to another report, and so would a
+        // drawing next to another report.json.
+        Some(dir) => {
+            anyhow::ensure!(
+                !dir.join("report.json").exists(),
+                "--out {} holds another report.json: draw this report elsewhere",
+                dir.display()
+            );
+            OutDir::claim(dir, outdir::DRAWING, args.force)
+        }
+    }
+    .context("--out")?;
+    let drawn = render(&report, claimed.path())
+        .with_context(|| format!("drawing {}", args.report.display()))?;
+    print_rendered(&drawn);
     Ok(ExitCode::SUCCESS)
+}
+
+/// Whether two paths name one directory (both exist once claimed; compared canonically).
+fn same_dir(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
 }
 
 /// One line naming what was drawn.
 pub(crate) fn print_rendered(r: &Rendered) {
     println!(
         "page: {} ({} charts, {} images)",
-        r.index.display(),
+        raybench_scenes::printable(&r.index.display().to_string()),
         r.charts.len(),
         r.images.len()
     );

@@ -1,10 +1,8 @@
 //! `raybench run`: build, time, count and check every structure; write report.json and draw it.
 
 use super::report::print_rendered;
-use super::{
-    DEFAULT_POINTS, Defaults, Selection, all_structures, check_outputs, default_out_dir,
-    exit_status,
-};
+use super::{DEFAULT_POINTS, Defaults, Selection, all_structures, claim_outputs, exit_status};
+use crate::outdir;
 use crate::output::render::render;
 use crate::output::summary::summary_table;
 use crate::pipeline::run::{RunOptions, run as run_pipeline};
@@ -23,15 +21,19 @@ pub struct RunArgs {
     /// The structure every answer is checked against and every ratio is relative to.
     #[arg(long, default_value = "embree-medium")]
     reference: String,
-    /// Timed builds after one warm-up build.
-    #[arg(long, default_value_t = 3)]
+    /// Timed builds after one warm-up build (1 to 1000).
+    #[arg(long, default_value_t = 3, value_parser = super::bounds::runs)]
     build_runs: usize,
-    /// Timed trace passes after one warm-up pass.
-    #[arg(long, default_value_t = 5)]
+    /// Timed trace passes after one warm-up pass (1 to 1000).
+    #[arg(long, default_value_t = 5, value_parser = super::bounds::runs)]
     trace_runs: usize,
-    /// Output directory (default: reports/<date>-<revision>).
+    /// Output directory (default: a new reports/<date>-<revision>[-N]).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Replace the report, drawing and dumps of an earlier run in --out and --dump-hits
+    /// (without it, such a directory is refused).
+    #[arg(long)]
+    force: bool,
     /// Leave the per-pixel pictures of primary rays out of the report (smaller; for baselines).
     #[arg(long)]
     no_images: bool,
@@ -48,12 +50,18 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     };
     let r = args.selection.resolve(true, defaults)?;
     registry::find(&args.reference)?;
-    let dir = args.out.unwrap_or_else(default_out_dir);
-    check_outputs(&dir, args.dump_hits.as_deref())?;
+    let claimed = claim_outputs(
+        args.out.as_deref(),
+        outdir::RUN,
+        args.dump_hits.as_deref(),
+        args.force,
+    )?;
+    let dir = claimed.out.path();
     let sel = &args.selection;
     let opts = RunOptions {
         suite: sel.suite.clone(),
         structures: r.structures,
+        suite_limits: sel.suite.is_some() && sel.structures.is_empty(),
         workloads: r.workloads,
         rays: r.rays,
         points: r.points,
@@ -68,17 +76,33 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         dump_hits: args.dump_hits.clone(),
     };
     let report = run_pipeline(&opts, &r.requests)?;
-    let path = report.write_atomic(&dir)?;
+    let path = report.write_atomic(dir)?;
     print!("{}", summary_table(&report));
-    println!("report: {}", path.display());
+    println!(
+        "report: {}",
+        raybench_scenes::printable(&path.display().to_string())
+    );
     if let Some(d) = &args.dump_hits {
-        println!("hit dumps: {}", d.display());
+        println!(
+            "hit dumps: {}",
+            raybench_scenes::printable(&d.display().to_string())
+        );
     }
-    // The report is safe on disk first: a drawing failure is reported, never loses it.
-    match render(&report, &dir) {
-        Ok(r) => print_rendered(&r),
-        Err(e) => eprintln!("raybench: drawing the report failed: {e:#}"),
-    }
+    // The report is safe on disk first: a drawing failure is reported and fails the command
+    // (exit 1 unless a mismatch says 2), but never loses the report.
+    let drawn = match render(&report, dir) {
+        Ok(r) => {
+            print_rendered(&r);
+            true
+        }
+        Err(e) => {
+            eprintln!(
+                "raybench: error: drawing the report failed ({} is kept): {e:#}",
+                path.display()
+            );
+            false
+        }
+    };
     if report.mismatches() > 0 {
         eprintln!(
             "raybench: {} mismatches against {}",
@@ -86,5 +110,8 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             report.run.reference
         );
     }
-    Ok(exit_status(report.mismatches(), report.errors.len()))
+    Ok(exit_status(
+        report.mismatches(),
+        report.errors.len() + usize::from(!drawn),
+    ))
 }

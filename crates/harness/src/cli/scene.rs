@@ -9,7 +9,7 @@
 use crate::output::preview::preview;
 use anyhow::{Result, bail};
 use clap::{Args, Subcommand};
-use raybench_scenes::{GeneratorInfo, Kind};
+use raybench_scenes::GeneratorInfo;
 use std::io::{self, Write};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
@@ -30,31 +30,12 @@ pub fn real_scenes() -> io::Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-/// Triangle budget used to learn a generator's views: views come from the generator's layout,
-/// not from its size, and a few hundred triangles cost nothing.
-const VIEW_PROBE_TRIANGLES: u64 = 200;
-
-/// The spec [`write_generators`] generates to learn the views of `info`: the generator at
-/// `VIEW_PROBE_TRIANGLES` if it has a `triangles` parameter, else at its defaults.
-pub fn view_probe_spec(info: &GeneratorInfo) -> String {
-    match info.params.iter().find(|p| p.key == "triangles") {
-        Some(p) => {
-            let n = match p.kind {
-                Kind::Count { min, max } => VIEW_PROBE_TRIANGLES.clamp(min, max),
-                Kind::Real { .. } => VIEW_PROBE_TRIANGLES,
-            };
-            format!("{}:triangles={n}", info.name)
-        }
-        None => info.name.to_owned(),
-    }
-}
-
 /// The names of `info`'s views, by generating it small; the error says what failed (a generator
 /// error, or a panic, which is caught so one broken generator does not hide the others).
 pub fn generator_views(info: &GeneratorInfo) -> Result<Vec<String>, String> {
-    let spec = view_probe_spec(info);
-    match catch_unwind(AssertUnwindSafe(|| raybench_scenes::generate(&spec, 1))) {
-        Ok(Ok(scene)) => Ok(scene.views.into_iter().map(|v| v.name).collect()),
+    let spec = raybench_scenes::view_probe_spec(info);
+    match catch_unwind(AssertUnwindSafe(|| raybench_scenes::view_names(info))) {
+        Ok(Ok(names)) => Ok(names),
         Ok(Err(e)) => Err(e.to_string()),
         Err(panic) => Err(format!(
             "generator spec `{spec}`: panicked: {}",
@@ -218,7 +199,7 @@ pub fn export(name: &str, triangles: Option<u64>, seed: u64, out: &Path) -> Resu
         env!("CARGO_PKG_VERSION"),
         scene.name
     );
-    raybench_scenes::write_obj(&scene.mesh, &header, out)?;
+    crate::atomic::write_atomic_with(out, |w| raybench_scenes::write_obj(&scene.mesh, &header, w))?;
     let written = raybench_scenes::in_file_order(&scene.mesh);
     let mut notes = scene.loader_notes.clone();
     let removed = scene.removed;

@@ -1,9 +1,9 @@
 //! `raybench verify`: check answers, not speed, against three references; write verify.json.
 
 use super::{
-    DEFAULT_POINTS, Defaults, Selection, all_structures, budget, check_outputs, default_out_dir,
-    exit_status,
+    DEFAULT_POINTS, Defaults, Selection, all_structures, budget, claim_outputs, exit_status,
 };
+use crate::outdir;
 use crate::output::verify_table::verify_table;
 use crate::pipeline::verify::{BRUTE_FORCE_BUDGET, VerifyOptions, verify};
 use anyhow::Result;
@@ -16,9 +16,12 @@ use std::process::ExitCode;
 pub struct VerifyArgs {
     #[command(flatten)]
     pub selection: Selection,
-    /// Output directory for verify.json (default: reports/<date>-<revision>).
+    /// Output directory for verify.json (default: a new reports/<date>-<revision>[-N]).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Replace the verify.json and dumps of an earlier command in --out and --dump-hits.
+    #[arg(long)]
+    pub force: bool,
     /// Write every ray and each structure's answer here (see docs/report-format.md, "Hit dumps").
     #[arg(long)]
     pub dump_hits: Option<PathBuf>,
@@ -39,8 +42,13 @@ pub fn run(args: VerifyArgs) -> Result<ExitCode> {
         points: DEFAULT_POINTS,
     };
     let r = args.selection.resolve(false, defaults)?;
-    let dir = args.out.unwrap_or_else(default_out_dir);
-    check_outputs(&dir, args.dump_hits.as_deref())?;
+    let claimed = claim_outputs(
+        args.out.as_deref(),
+        outdir::VERIFY,
+        args.dump_hits.as_deref(),
+        args.force,
+    )?;
+    let dir = claimed.out.path();
     let opts = VerifyOptions {
         suite: args.selection.suite.clone(),
         structures: r.structures,
@@ -55,11 +63,17 @@ pub fn run(args: VerifyArgs) -> Result<ExitCode> {
         dump_hits: args.dump_hits.clone(),
     };
     let report = verify(&opts, &r.requests)?;
-    let path = report.write_atomic(&dir)?;
+    let path = report.write_atomic(dir)?;
     print!("{}", verify_table(&report));
-    println!("verify: {}", path.display());
+    println!(
+        "verify: {}",
+        raybench_scenes::printable(&path.display().to_string())
+    );
     if let Some(d) = &args.dump_hits {
-        println!("hit dumps: {}", d.display());
+        println!(
+            "hit dumps: {}",
+            raybench_scenes::printable(&d.display().to_string())
+        );
     }
     Ok(exit_status(report.mismatches(), report.errors.len()))
 }

@@ -1,12 +1,11 @@
 //! `raybench watertight`: crack hunting; write watertight.json and print the miss rates.
 
-use super::{all_structures, at_least_one, budget, default_out_dir, exit_status, pick};
-use crate::atomic::ensure_writable_dir;
+use super::{all_structures, at_least_one, budget, exit_status, pick};
 use crate::output::watertight_table::watertight_table;
 use crate::pipeline::verify::BRUTE_FORCE_BUDGET;
 use crate::pipeline::watertight::{WatertightOptions, default_cases, watertight};
 use crate::registry;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -21,12 +20,15 @@ pub struct WatertightArgs {
     pub rays: usize,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Worker threads for builds and traces.
-    #[arg(long, default_value_t = 1, value_parser = at_least_one)]
+    /// Worker threads for builds and traces; at most 8 per core.
+    #[arg(long, default_value_t = 1, value_parser = super::bounds::threads)]
     pub threads: usize,
-    /// Output directory for watertight.json (default: reports/<date>-<revision>).
+    /// Output directory for watertight.json (default: a new reports/<date>-<revision>[-N]).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Replace the watertight.json of an earlier command in --out.
+    #[arg(long)]
+    pub force: bool,
     /// Ray–triangle tests brute force may spend per case (it traces an evenly spaced subsample).
     #[arg(long, default_value_t = BRUTE_FORCE_BUDGET, value_parser = budget)]
     pub brute_force_budget: u64,
@@ -36,8 +38,15 @@ pub struct WatertightArgs {
 pub fn run(args: WatertightArgs) -> Result<ExitCode> {
     let structures = pick(args.structures, None, all_structures);
     registry::select(&structures)?;
-    let dir = args.out.unwrap_or_else(default_out_dir);
-    ensure_writable_dir(&dir).context("--out")?;
+    super::no_duplicates("--structures", structures.iter().cloned())?;
+    super::bounds::check_rays(args.rays, 1, false)?;
+    let claimed = super::claim_outputs(
+        args.out.as_deref(),
+        crate::outdir::WATERTIGHT,
+        None,
+        args.force,
+    )?;
+    let dir = claimed.out.path();
     let opts = WatertightOptions {
         cases: default_cases(),
         structures,
@@ -47,8 +56,11 @@ pub fn run(args: WatertightArgs) -> Result<ExitCode> {
         brute_force_budget: args.brute_force_budget,
     };
     let report = watertight(&opts)?;
-    let path = report.write_atomic(&dir)?;
+    let path = report.write_atomic(dir)?;
     print!("{}", watertight_table(&report));
-    println!("watertight: {}", path.display());
+    println!(
+        "watertight: {}",
+        raybench_scenes::printable(&path.display().to_string())
+    );
     Ok(exit_status(0, report.errors.len()))
 }

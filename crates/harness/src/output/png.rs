@@ -1,8 +1,8 @@
-//! PNG files from RGB pixels, written atomically through plotters' bitmap backend (no text is
+//! PNG files from RGB pixels, encoded by the `png` crate and written atomically (no text is
 //! drawn, so no fonts are read).
 
-use anyhow::{Context, Result, anyhow, bail};
-use plotters::prelude::{BitMapBackend, DrawingBackend};
+use crate::atomic::write_atomic_with;
+use anyhow::{Result, bail};
 use std::path::Path;
 
 /// Largest preview side, and largest pixel count (64 Mi pixels = 192 MiB of RGB).
@@ -19,8 +19,8 @@ pub(crate) fn check_size(width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
-/// Writes RGB pixels (row-major from the top-left) as a PNG, atomically: a temporary `.png`
-/// next to `out` (plotters picks the format from the extension), then a rename over `out`.
+/// Writes RGB pixels (row-major from the top-left) as a PNG file, atomically
+/// ([`crate::atomic`]).
 pub fn write_png(pixels: &[[u8; 3]], width: u32, height: u32, out: &Path) -> Result<()> {
     check_size(width, height)?;
     anyhow::ensure!(
@@ -28,26 +28,14 @@ pub fn write_png(pixels: &[[u8; 3]], width: u32, height: u32, out: &Path) -> Res
         "{} pixels for a {width}×{height} image",
         pixels.len()
     );
-    let name = out
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "preview.png".into());
-    let tmp = out.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
-    let result = (|| -> Result<()> {
-        let flat: Vec<u8> = pixels.iter().flatten().copied().collect();
-        let mut backend = BitMapBackend::new(&tmp, (width, height));
-        backend
-            .blit_bitmap((0, 0), (width, height), &flat)
-            .map_err(|e| anyhow!("{}: {e}", tmp.display()))?;
-        backend
-            .present()
-            .map_err(|e| anyhow!("{}: {e}", tmp.display()))?;
-        drop(backend);
-        std::fs::rename(&tmp, out)
-            .with_context(|| format!("{} (renaming {} over it)", out.display(), tmp.display()))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    write_atomic_with(out, |w| {
+        let mut encoder = png::Encoder::new(w, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+        writer
+            .write_image_data(pixels.as_flattened())
+            .map_err(std::io::Error::other)?;
+        writer.finish().map_err(std::io::Error::other)
+    })
 }

@@ -110,7 +110,7 @@ fn write_agreement(out: &mut String, report: &Report) {
         // two different questions.
         for (point_query, what) in [(false, "rays"), (true, "queries")] {
             let mut counts = VerdictCounts::default();
-            let mut counted_differs = 0;
+            let (mut counted_differs, mut counted_explained) = (0, 0);
             let workloads = report
                 .results
                 .iter()
@@ -120,6 +120,7 @@ fn write_agreement(out: &mut String, report: &Report) {
             for w in workloads {
                 counts += w.agreement.counts;
                 counted_differs += w.agreement.counted_path_differs;
+                counted_explained += w.agreement.counted_path_explained;
             }
             if counts.total() == 0 && counted_differs == 0 {
                 continue;
@@ -131,7 +132,7 @@ fn write_agreement(out: &mut String, report: &Report) {
                 "  {name}{kind}: {}; {}{}",
                 agreement_sentence_of(&counts, what),
                 class_counts(&counts),
-                counted_path_note(counted_differs)
+                counted_path_note(counted_differs, counted_explained)
             );
         }
     }
@@ -181,13 +182,22 @@ fn write_point_work(out: &mut String, report: &Report) {
     }
 }
 
-/// Said only when it happens: the counted walk answering differently is a bug of its own.
-pub(crate) fn counted_path_note(rays: u64) -> String {
-    if rays == 0 {
-        String::new()
-    } else {
-        format!("; the counted path answered differently from the timed path on {rays} rays")
+/// Said only when it happens: the counted walk answering differently without an explanation
+/// is a bug of its own; explained differences (ties, edge-ambiguous rays) are counted apart.
+pub(crate) fn counted_path_note(unexplained: u64, explained: u64) -> String {
+    let mut note = String::new();
+    if unexplained > 0 {
+        note += &format!(
+            "; the counted path answered differently from the timed path on {unexplained} rays"
+        );
     }
+    if explained > 0 {
+        note += &format!(
+            "; the timed and counted paths differ on {explained} rays, each one explained \
+             (tie, edge-ambiguous, boundary or within tolerance)"
+        );
+    }
+    note
 }
 
 fn truncate(s: &str, n: usize) -> String {

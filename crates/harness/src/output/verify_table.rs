@@ -117,6 +117,8 @@ pub fn verify_table(report: &VerifyReport) -> String {
         "mismatch",
         "cnt≠timed"
     );
+    // cnt≠timed: counted-path answers that differ from the timed path's with no explanation
+    // (explained differences are listed in the notes below).
     for row in &report.totals {
         let c = &row.counts;
         let _ = writeln!(

@@ -136,38 +136,49 @@ pub fn counted_point_differences(timed: &[Option<PointHit>], counted: &[Option<P
 /// How the counted walk's answers compare with the timed path's.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PathDifferences {
-    /// Rays answered differently (a bug in one of the two paths).
+    /// Rays answered differently for no reason the f64 arbiter accepts: a bug in one of the
+    /// two paths.
     pub differs: u64,
-    /// Closest-hit rays where the two paths report different triangles at the same distance
-    /// (a [`Verdict::Tie`]): a packet walk meets triangles in another order than the single-ray
-    /// walk, so on an exact tie it may keep the other one. Every other difference counts in
-    /// `differs`, including the same triangle at a different `t` (both paths compute a
-    /// triangle's hit with the same arithmetic).
-    pub ties: u64,
+    /// Rays answered differently for an explained reason, classified like any disagreement
+    /// with a reference: a tie (a packet walk meets triangles in another order than the
+    /// single-ray walk, and keeps the other of two equally near ones), an edge-ambiguous ray
+    /// (two entry points of one library, such as Embree's stream and single-ray calls,
+    /// deciding a ray that grazes an edge differently), a boundary hit or a `t` within
+    /// tolerance.
+    pub explained: u64,
 }
 
-/// Compares the counted walk's answers with the timed path's, ray by ray.
+/// Compares the counted walk's answers with the timed path's, ray by ray, classifying every
+/// difference with the validation classes. `accel` answers the closest hits an any-hit
+/// dispute is arbitrated with.
 pub fn counted_path_differences(
     mesh: &TriangleMesh,
     rays: &[Ray],
     timed: &Answers,
     counted: &Answers,
     tol: &Tolerance,
+    accel: &dyn Accel,
 ) -> PathDifferences {
     let mut d = PathDifferences::default();
+    let mut count = |verdict: Verdict| match verdict {
+        Verdict::Mismatch => d.differs += 1,
+        _ => d.explained += 1,
+    };
     match (timed, counted) {
         (Answers::Closest(a), Answers::Closest(b)) => {
             for ((x, y), ray) in a.iter().zip(b).zip(rays) {
-                if x == y {
-                    continue;
+                if x != y {
+                    count(classify(mesh, ray, *x, *y, tol));
                 }
-                let tie = x.zip(*y).is_some_and(|(p, q)| p.prim != q.prim)
-                    && classify(mesh, ray, *x, *y, tol) == Verdict::Tie;
-                *(if tie { &mut d.ties } else { &mut d.differs }) += 1;
             }
         }
         (Answers::Any(a), Answers::Any(b)) => {
-            d.differs = a.iter().zip(b).filter(|(x, y)| x != y).count() as u64;
+            for ((&x, &y), ray) in a.iter().zip(b).zip(rays) {
+                if x != y {
+                    let hits = || (accel.intersect(ray), accel.intersect(ray));
+                    count(classify_occlusion(mesh, ray, x, y, hits, tol));
+                }
+            }
         }
         _ => d.differs = timed.len() as u64,
     }

@@ -38,11 +38,12 @@
 //! ("t","<f4"),("prim","<u4"),("u","<f4"),("v","<f4")], offset=32)`.
 
 use super::measure::Answers;
-use crate::atomic::{ensure_writable_dir, write_atomic};
+use crate::atomic::write_atomic;
 use anyhow::{Context, Result, bail, ensure};
 use raybench_accel::Hit;
 use raybench_geom::Ray;
 use raybench_scenes::Workload;
+use raybench_scenes::input::read_input;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -151,7 +152,7 @@ fn u32_at(bytes: &[u8], at: usize) -> u32 {
 
 /// Reads a dump file back, checking the magic, version, record size and length.
 pub fn read_dump(path: &Path) -> Result<HitDump> {
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let bytes = read_input(path)?;
     decode(&bytes).with_context(|| format!("{}", path.display()))
 }
 
@@ -215,9 +216,11 @@ pub struct DumpDir {
 }
 
 impl DumpDir {
-    /// Creates `dir` and checks it is writable before any work is done.
+    /// Dumps into `dir` (created if needed). The commands claim it first (`crate::outdir`:
+    /// locked, checked, proven writable) before any work.
     pub fn create(dir: &Path) -> Result<DumpDir> {
-        ensure_writable_dir(dir).context("--dump-hits")?;
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--dump-hits {} cannot be created", dir.display()))?;
         Ok(DumpDir {
             dir: dir.to_path_buf(),
             used: HashSet::new(),
@@ -299,7 +302,7 @@ pub(crate) fn points_not_dumped(dumping: bool, workloads: &[Workload]) -> Option
 /// Reads `index.json` of a dump directory.
 pub fn read_index(dir: &Path) -> Result<DumpIndex> {
     let path = dir.join("index.json");
-    let bytes = std::fs::read(&path).with_context(|| format!("reading {}", path.display()))?;
+    let bytes = read_input(&path)?;
     serde_json::from_slice(&bytes).with_context(|| format!("parsing {}", path.display()))
 }
 

@@ -52,7 +52,7 @@ impl PrimaryImage {
     pub fn new(width: u32, height: u32, pixels: &[PixelInput]) -> PrimaryImage {
         assert_eq!(
             pixels.len(),
-            (width * height) as usize,
+            width as usize * height as usize,
             "one input per pixel"
         );
         let f = width.div_ceil(MAX_WIDTH).max(1);
@@ -87,8 +87,9 @@ impl PrimaryImage {
         }
     }
 
+    /// Width × height, in `usize` so a report's sizes cannot overflow it.
     pub fn pixels(&self) -> usize {
-        (self.width * self.height) as usize
+        self.width as usize * self.height as usize
     }
 
     /// The decoded cost plane, checked against the image size.
@@ -169,7 +170,7 @@ pub fn base64_decode(text: &str) -> Result<Vec<u8>, String> {
             .iter()
             .position(|&a| a == c)
             .map(|p| p as u32)
-            .ok_or_else(|| format!("invalid base64 character {:?}", c as char))
+            .ok_or_else(|| format!("invalid base64 character {}", (c as char).escape_default()))
     };
     let mut out = Vec::with_capacity(bytes.len() / 4 * 3);
     for (k, quad) in bytes.chunks(4).enumerate() {

@@ -27,6 +27,7 @@ impl Progress {
 
     /// Called between measurements only, never inside a timed region.
     pub(crate) fn step(&self, msg: String) {
+        let msg = raybench_scenes::printable(&msg).into_owned();
         match &self.bar {
             Some(pb) => {
                 pb.set_message(msg);
@@ -37,6 +38,7 @@ impl Progress {
     }
 
     pub(crate) fn note(&self, msg: String) {
+        let msg = raybench_scenes::printable(&msg).into_owned();
         match &self.bar {
             Some(pb) => pb.println(msg),
             None => eprintln!("raybench: {msg}"),

@@ -13,12 +13,13 @@ pub struct Agreement {
     /// `edge_ambiguous`, `mismatch` (written flat into this object).
     #[serde(flatten)]
     pub counts: VerdictCounts,
-    /// Rays where the counted path answered differently from the timed path (a bug).
+    /// Rays where the counted path answered differently from the timed path, unexplained (a
+    /// mismatch between the two: a bug).
     pub counted_path_differs: u64,
-    /// Rays where the timed path (a packet walk of coherent rays) and the counted single-ray
-    /// walk report different triangles at the same distance: an order-decided tie, not a bug.
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub counted_path_ties: u64,
+    /// Rays where the two paths differ for an explained reason (a tie, an edge-ambiguous ray,
+    /// a boundary hit, `t` within tolerance; see `pipeline::check::PathDifferences`).
+    #[serde(default, skip_serializing_if = "is_zero", alias = "counted_path_ties")]
+    pub counted_path_explained: u64,
     /// With 0 mismatches in n rays, the 95 % upper bound on the mismatch rate (rule of three).
     pub mismatch_rate_upper95: f64,
     pub first_mismatches: Vec<DisputedRay>,
@@ -41,7 +42,7 @@ impl Agreement {
             reference: reference.to_string(),
             counts,
             counted_path_differs: 0,
-            counted_path_ties: 0,
+            counted_path_explained: 0,
             mismatch_rate_upper95: upper95,
             first_mismatches: Vec::new(),
             first_ambiguous: Vec::new(),

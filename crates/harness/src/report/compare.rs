@@ -79,8 +79,38 @@ fn keyed(report: &Report) -> BTreeMap<Key, &ResultEntry> {
         .collect()
 }
 
+/// Every scene × structure, and scene × structure × workload, a report lists more than once.
+/// A real run never makes one (its lists are checked for duplicates), but a report edited or
+/// merged by hand can, and keying it would keep one copy and silently drop the other.
+pub fn duplicate_entries(report: &Report) -> Vec<String> {
+    let mut seen = std::collections::BTreeSet::new();
+    let mut twice = Vec::new();
+    for r in &report.results {
+        if !seen.insert((r.scene.as_str(), r.structure.as_str(), "")) {
+            twice.push(format!("{} / {}", r.scene, r.structure));
+        }
+        for w in &r.workloads {
+            if !seen.insert((r.scene.as_str(), r.structure.as_str(), w.workload.as_str())) {
+                twice.push(format!("{} / {} / {}", r.scene, r.structure, w.workload));
+            }
+        }
+    }
+    twice
+}
+
 pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison {
     let mut findings = Vec::new();
+    for (which, report) in [("base", base), ("new", new)] {
+        for twice in duplicate_entries(report) {
+            findings.push(Finding {
+                severity: Severity::Regression,
+                what: format!(
+                    "the {which} report lists {twice} more than once: a report with duplicate \
+                     entries cannot be compared (one copy would hide the other)"
+                ),
+            });
+        }
+    }
     let comparable = environment_warnings(base, new, &mut findings);
     for e in &new.errors {
         findings.push(Finding {

@@ -10,6 +10,7 @@ pub mod watertight;
 
 use crate::env::Environment;
 use anyhow::{Context, Result, ensure};
+use raybench_scenes::input::read_input;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::ops::RangeInclusive;
@@ -44,7 +45,7 @@ pub fn read_report<T: DeserializeOwned>(path: &Path, versions: RangeInclusive<u3
     struct Version {
         schema_version: Option<u32>,
     }
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let bytes = read_input(path)?;
     let found = serde_json::from_slice::<Version>(&bytes)
         .with_context(|| format!("parsing {}", path.display()))?
         .schema_version;

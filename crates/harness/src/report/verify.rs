@@ -79,8 +79,13 @@ pub struct VerifiedWorkload {
     #[serde(alias = "rays")]
     pub queries: usize,
     pub subsampled: bool,
-    /// Queries where the counted path answered differently from the timed path (a bug).
+    /// Queries where the counted path answered differently from the timed path, unexplained
+    /// (a bug).
     pub counted_path_differs: u64,
+    /// Queries where the two paths differ for an explained reason (classified like any
+    /// disagreement: tie, edge-ambiguous, boundary, within tolerance).
+    #[serde(default)]
+    pub counted_path_explained: u64,
     /// One per reference, in [`crate::pipeline::verify::REFERENCES`] order. Disputed queries
     /// carry their index in the workload's full list.
     #[serde(alias = "validations")]
@@ -96,6 +101,8 @@ pub struct AgreementRow {
     #[serde(flatten)]
     pub counts: VerdictCounts,
     pub counted_path_differs: u64,
+    #[serde(default)]
+    pub counted_path_explained: u64,
     pub mismatch_rate_upper95: f64,
     /// "0 mismatches in n rays (95% upper bound 3/n = …)" or "k mismatches in n rays".
     pub agreement: String,

@@ -156,10 +156,50 @@ pub fn generators() -> &'static [GeneratorInfo] {
     GENERATORS
 }
 
-/// Checks a spec (generator name, parameter names and values) without generating anything:
-/// cheap even for 10M-triangle specs. View names are checked when the scene is generated.
+/// Checks a spec (generator name, parameter names and values, and the view if one is named)
+/// without generating the scene: cheap even for 10M-triangle specs.
 pub fn check_spec(spec: &str) -> Result<(), SceneError> {
-    parse_spec(spec).map(|_| ())
+    let parsed = parse_spec(spec)?;
+    if let Some(name) = &parsed.view {
+        let names = view_names(parsed.info)?;
+        if !names.contains(name) {
+            return Err(unknown_view(spec, name, &names));
+        }
+    }
+    Ok(())
+}
+
+/// Triangle budget used to learn a generator's views: views come from the generator's layout,
+/// not from its size, and a few hundred triangles cost nothing.
+const VIEW_PROBE_TRIANGLES: u64 = 200;
+
+/// The spec [`view_names`] generates: the generator at `VIEW_PROBE_TRIANGLES` if it has a
+/// `triangles` parameter, else at its defaults.
+pub fn view_probe_spec(info: &GeneratorInfo) -> String {
+    match info.params.iter().find(|p| p.key == "triangles") {
+        Some(p) => {
+            let n = match p.kind {
+                Kind::Count { min, max } => VIEW_PROBE_TRIANGLES.clamp(min, max),
+                Kind::Real { .. } => VIEW_PROBE_TRIANGLES,
+            };
+            format!("{}:triangles={n}", info.name)
+        }
+        None => info.name.to_owned(),
+    }
+}
+
+/// The names of a generator's views (the first is its default), learned by generating it
+/// small ([`view_probe_spec`]).
+pub fn view_names(info: &GeneratorInfo) -> Result<Vec<String>, SceneError> {
+    let scene = generate(&view_probe_spec(info), 1)?;
+    Ok(scene.views.into_iter().map(|v| v.name).collect())
+}
+
+fn unknown_view(spec: &str, name: &str, known: &[String]) -> SceneError {
+    SceneError::generator(
+        spec,
+        format!("unknown view `{name}` (known: {})", known.join(", ")),
+    )
 }
 
 /// Makes a procedural scene from a spec.
@@ -217,11 +257,8 @@ fn pick_view(spec: &str, views: &[NamedView], wanted: Option<&str>) -> Result<Vi
         .find(|v| v.name == name)
         .map(|v| v.view)
         .ok_or_else(|| {
-            let known: Vec<_> = views.iter().map(|v| v.name.as_str()).collect();
-            SceneError::generator(
-                spec,
-                format!("unknown view `{name}` (known: {})", known.join(", ")),
-            )
+            let known: Vec<String> = views.iter().map(|v| v.name.clone()).collect();
+            unknown_view(spec, name, &known)
         })
 }
 
@@ -365,6 +402,14 @@ mod tests {
     fn unknown_view_is_an_error_naming_the_views() {
         let err = generate("sphere:view=sideways", 1).unwrap_err().to_string();
         assert!(err.contains("sideways") && err.contains("default"), "{err}");
+        let checked = check_spec("sphere:view=sideways").unwrap_err().to_string();
+        assert_eq!(checked, err);
+        let err = check_spec("teapot-in-stadium:view=nowhere,size_ratio=1e-4")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("`nowhere` (known: closeup, stadium)"), "{err}");
+        assert!(check_spec("teapot-in-stadium:view=stadium,size_ratio=1e-4").is_ok());
+        assert!(check_spec("sphere:view=default").is_ok());
         assert!(generate("sphere:view=default", 1).is_ok());
     }
 }

@@ -16,48 +16,43 @@
 //!   same three vertices, bit for bit, before and after.
 //!   Non-finite vertices are only ever used by triangles [`TriangleMesh::new`] removed, so they
 //!   are never written.
-//! * The file appears atomically: it is written to a temporary file next to `out`, synced, then
-//!   renamed over `out`. On any error the temporary file is removed and `out` is untouched.
+//! * [`write_obj`] writes to any `Write`: the harness streams it into its atomic file writer,
+//!   so the file appears whole or not at all.
 
 use raybench_geom::TriangleMesh;
-use std::fs::File;
-use std::io::{self, BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::io::{self, Write};
 
-/// Writes `mesh` to `out` as OBJ, every line of `header` first as a `# ` comment. Loading the
-/// file gives [`in_file_order`]`(mesh)` exactly (see the module documentation).
-///
-/// Errors name the path (`out`, or the temporary file next to it).
-pub fn write_obj(mesh: &TriangleMesh, header: &str, out: &Path) -> io::Result<()> {
-    let tmp = temp_path(out);
-    let result = write_to(&tmp, &in_file_order(mesh), header)
-        .map_err(|e| {
-            with_path(
-                e,
-                &format!(
-                    "{}: cannot write the temporary file {}",
-                    out.display(),
-                    tmp.display()
-                ),
-            )
-        })
-        .and_then(|()| {
-            std::fs::rename(&tmp, out).map_err(|e| {
-                with_path(
-                    e,
-                    &format!(
-                        "{}: cannot rename the temporary file {} over it",
-                        out.display(),
-                        tmp.display()
-                    ),
-                )
-            })
-        });
-    if result.is_err() {
-        // Best effort: the file may never have been created.
-        let _ = std::fs::remove_file(&tmp);
+/// Writes `mesh` as OBJ text to `w`, every line of `header` first as a `# ` comment. Loading
+/// the text gives [`in_file_order`]`(mesh)` exactly (see the module documentation).
+pub fn write_obj(mesh: &TriangleMesh, header: &str, w: &mut dyn Write) -> io::Result<()> {
+    let mesh = in_file_order(mesh);
+    for line in header.lines() {
+        if line.is_empty() {
+            writeln!(w, "#")?;
+        } else {
+            writeln!(w, "# {line}")?;
+        }
     }
-    result
+    writeln!(
+        w,
+        "# {} vertices, {} triangles",
+        mesh.positions().len(),
+        mesh.len()
+    )?;
+    for p in mesh.positions() {
+        writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    for [a, b, c] in mesh.indices() {
+        // In u64: index u32::MAX + 1 would overflow u32.
+        writeln!(
+            w,
+            "f {} {} {}",
+            u64::from(*a) + 1,
+            u64::from(*b) + 1,
+            u64::from(*c) + 1
+        )?;
+    }
+    Ok(())
 }
 
 /// `mesh` with its vertices renumbered in order of first use by the triangles (corners in
@@ -90,61 +85,17 @@ pub fn in_file_order(mesh: &TriangleMesh) -> TriangleMesh {
         .0
 }
 
-/// `DIR/.NAME.tmp-PID`: same directory (so the rename is atomic), hidden, unique per process.
-fn temp_path(out: &Path) -> PathBuf {
-    let name = out
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "export.obj".to_owned());
-    out.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
-}
-
-fn write_to(tmp: &Path, mesh: &TriangleMesh, header: &str) -> io::Result<()> {
-    let mut w = BufWriter::with_capacity(1 << 20, File::create(tmp)?);
-    for line in header.lines() {
-        if line.is_empty() {
-            writeln!(w, "#")?;
-        } else {
-            writeln!(w, "# {line}")?;
-        }
-    }
-    writeln!(
-        w,
-        "# {} vertices, {} triangles",
-        mesh.positions().len(),
-        mesh.len()
-    )?;
-    for p in mesh.positions() {
-        writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
-    }
-    for [a, b, c] in mesh.indices() {
-        // In u64: index u32::MAX + 1 would overflow u32.
-        writeln!(
-            w,
-            "f {} {} {}",
-            u64::from(*a) + 1,
-            u64::from(*b) + 1,
-            u64::from(*c) + 1
-        )?;
-    }
-    w.into_inner().map_err(|e| e.into_error())?.sync_all()
-}
-
-fn with_path(e: io::Error, what: &str) -> io::Error {
-    io::Error::new(e.kind(), format!("{what}: {e}"))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::load_obj;
+    use crate::load_obj_bytes;
     use raybench_geom::Vec3;
+    use std::path::Path;
 
-    fn temp_dir(tag: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("raybench-export-{tag}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn exported(mesh: &TriangleMesh, header: &str) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        write_obj(mesh, header, &mut bytes).unwrap();
+        bytes
     }
 
     fn bits(m: &TriangleMesh) -> Vec<[u32; 3]> {
@@ -166,15 +117,12 @@ mod tests {
         ];
         let (mesh, _) = TriangleMesh::new(positions, vec![[0, 1, 2], [2, 1, 3]]).unwrap();
         assert_eq!(in_file_order(&mesh), mesh, "already in first-use order");
-        let dir = temp_dir("awkward");
-        let out = dir.join("a.obj");
-        write_obj(&mesh, "test\n\nsecond line", &out).unwrap();
-        let text = std::fs::read_to_string(&out).unwrap();
+        let bytes = exported(&mesh, "test\n\nsecond line");
+        let text = String::from_utf8(bytes.clone()).unwrap();
         assert!(text.starts_with("# test\n#\n# second line\n"), "{text}");
-        let back = load_obj(&out).unwrap();
+        let back = load_obj_bytes(Path::new("a.obj"), &bytes).unwrap();
         assert_eq!(bits(&back.mesh), bits(&mesh));
         assert_eq!(back.mesh.indices(), mesh.indices());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// Vertices out of first-use order, unused (one of them NaN, used only by a triangle the
@@ -196,10 +144,7 @@ mod tests {
         let canonical = in_file_order(&mesh);
         assert_eq!(canonical.indices(), &[[0, 1, 2], [3, 1, 0], [2, 2, 3]]);
         assert_eq!(canonical.positions().len(), 4);
-        let dir = temp_dir("order");
-        let out = dir.join("o.obj");
-        write_obj(&mesh, "", &out).unwrap();
-        let back = load_obj(&out).unwrap();
+        let back = load_obj_bytes(Path::new("o.obj"), &exported(&mesh, "")).unwrap();
         assert_eq!(bits(&back.mesh), bits(&canonical));
         assert_eq!(back.mesh.indices(), canonical.indices());
         for i in 0..mesh.len() {
@@ -209,28 +154,5 @@ mod tests {
             };
             assert_eq!(t(&back.mesh), t(&mesh), "triangle {i}");
         }
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn failure_leaves_nothing_behind() {
-        let dir = temp_dir("fail");
-        let (mesh, _) =
-            TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap();
-        // The target is a directory: the rename fails after the data was written.
-        let target = dir.join("is-a-dir.obj");
-        std::fs::create_dir(&target).unwrap();
-        let err = write_obj(&mesh, "", &target).unwrap_err().to_string();
-        assert!(err.contains("is-a-dir.obj"), "{err}");
-        // A missing directory: the temporary file cannot be created.
-        let missing = dir.join("no/such/dir/x.obj");
-        let err = write_obj(&mesh, "", &missing).unwrap_err().to_string();
-        assert!(err.contains("no/such/dir"), "{err}");
-        let left: Vec<_> = std::fs::read_dir(&dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name())
-            .collect();
-        assert_eq!(left, vec![std::ffi::OsString::from("is-a-dir.obj")]);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -89,13 +89,7 @@ fn scene_name(path: &Path) -> String {
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
-    // Check for a directory first: on Linux `read` of a directory fails with a vague EISDIR.
-    if path.is_dir() {
-        return Err(SceneError::IsDirectory {
-            path: path.to_owned(),
-        });
-    }
-    std::fs::read(path).map_err(|e| SceneError::io(path, e))
+    Ok(crate::input::read_input(path)?)
 }
 
 fn not_utf8(path: &Path, bytes: &[u8], error: std::str::Utf8Error) -> SceneError {

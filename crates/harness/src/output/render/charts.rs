@@ -56,8 +56,8 @@ impl Bars {
     }
 }
 
-fn plot_err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("drawing a chart: {e:?}")
+fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow!("drawing a chart: {e}")
 }
 
 /// Renders one chart to an SVG string.
@@ -105,6 +105,17 @@ fn short(label: &str) -> String {
     }
 }
 
+/// The extremes a chart's value axis spans. Any finite value may sit in a report (a speedup of
+/// 5e-324 after a bad run, a build time of 1e-300), but an axis needs finite ends with room
+/// around them: a log axis from 0 or to infinity has no end, and drawing its ticks would never
+/// finish. Values beyond these are drawn at the edge of the axis.
+const AXIS_MIN: f64 = 1e-30;
+const AXIS_MAX: f64 = 1e30;
+
+fn on_axis(v: f64) -> f64 {
+    v.clamp(AXIS_MIN, AXIS_MAX)
+}
+
 /// Bars for group `g`, series `s` span `[g - 0.4, g + 0.4]` split evenly between the series;
 /// x runs from -0.5 so that the integer ticks fall on group centres and carry their names.
 fn draw_bars<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &Bars) -> Result<()> {
@@ -118,7 +129,7 @@ fn draw_bars<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &Bars) -> Res
     let (lo, hi) = if values.is_empty() {
         (0.1, 1.0)
     } else {
-        (lo, hi)
+        (on_axis(lo), on_axis(hi))
     };
     let groups = c.groups.clone();
     let x_fmt = move |x: &f64| {
@@ -210,7 +221,7 @@ fn bar_rects(series: &Series, s: usize, width: f64, base: f64) -> Vec<Rect> {
             let v = (*v)?;
             (v.is_finite() && v > 0.0).then(|| {
                 let x0 = g as f64 - 0.4 + s as f64 * width;
-                [(x0, base), (x0 + width * 0.9, v)]
+                [(x0, base), (x0 + width * 0.9, on_axis(v))]
             })
         })
         .collect()
@@ -287,6 +298,7 @@ fn draw_loglog<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &LogLog) ->
     if points.is_empty() {
         (x0, x1, y0, y1) = (1.0, 10.0, 1.0, 10.0);
     }
+    let (x0, x1, y0, y1) = (on_axis(x0), on_axis(x1), on_axis(y0), on_axis(y1));
     let mut chart = ChartBuilder::on(area)
         .caption(&c.title, ("sans-serif", 18))
         .margin(12)
@@ -309,8 +321,8 @@ fn draw_loglog<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &LogLog) ->
         let col = color(i);
         let pts: Vec<(f64, f64)> = pts
             .iter()
-            .copied()
-            .filter(|&(x, y)| ok(x) && ok(y))
+            .filter(|&&(x, y)| ok(x) && ok(y))
+            .map(|&(x, y)| (on_axis(x), on_axis(y)))
             .collect();
         chart
             .draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
@@ -325,8 +337,8 @@ fn draw_loglog<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &LogLog) ->
         let grey = RGBColor(120 + 25 * (i as u8 % 4), 120, 120);
         let pts: Vec<(f64, f64)> = pts
             .iter()
-            .copied()
-            .filter(|&(x, y)| ok(x) && ok(y))
+            .filter(|&&(x, y)| ok(x) && ok(y))
+            .map(|&(x, y)| (on_axis(x), on_axis(y)))
             .collect();
         chart
             .draw_series(DashedLineSeries::new(pts, 6, 4, grey.stroke_width(1)))

@@ -106,22 +106,26 @@ fn write_pictures(
             let img = r.primary_image.as_ref().expect("filtered");
             let base = format!("{}--{}", slugs[&scene], slug(&r.structure));
             let file = |kind: &str| format!("images/{base}-{kind}.png");
-            let heat = match pictures::heatmap_pixels(img, max)? {
-                Some(px) => {
-                    let f = file("cost");
-                    pictures::write(&px, img, &dir.join(&f))?;
-                    written.push(dir.join(&f));
-                    Some(f)
-                }
-                None => None,
-            };
-            let render = file("render");
-            pictures::write(&pictures::shade_pixels(img)?, img, &dir.join(&render))?;
-            let mask = file("disagree");
-            pictures::write(&pictures::disagree_pixels(img)?, img, &dir.join(&mask))?;
-            written.push(dir.join(&render));
-            written.push(dir.join(&mask));
-            rows.push((r.structure.clone(), heat, render, mask));
+            let row = (|| -> Result<_> {
+                let heat = match pictures::heatmap_pixels(img, max)? {
+                    Some(px) => {
+                        let f = file("cost");
+                        pictures::write(&px, img, &dir.join(&f))?;
+                        written.push(dir.join(&f));
+                        Some(f)
+                    }
+                    None => None,
+                };
+                let render = file("render");
+                pictures::write(&pictures::shade_pixels(img)?, img, &dir.join(&render))?;
+                let mask = file("disagree");
+                pictures::write(&pictures::disagree_pixels(img)?, img, &dir.join(&mask))?;
+                written.push(dir.join(&render));
+                written.push(dir.join(&mask));
+                Ok((r.structure.clone(), heat, render, mask))
+            })()
+            .with_context(|| format!("the pictures of {scene} / {}", r.structure))?;
+            rows.push(row);
         }
         out.push(ScenePictures {
             scene,

@@ -6,7 +6,8 @@ use super::references::{
 };
 use super::{REFERENCES, VerifyOptions};
 use crate::pipeline::check::{
-    Sides, check_answers, check_points, counted_path_differences, counted_point_differences,
+    PathDifferences, Sides, check_answers, check_points, counted_path_differences,
+    counted_point_differences,
 };
 use crate::pipeline::dump::DumpDir;
 use crate::pipeline::measure::{Answers, count_pass, count_point_pass, point_pass, trace_pass};
@@ -136,6 +137,7 @@ impl Checker<'_> {
             queries: points.len(),
             subsampled: subject.sampled,
             counted_path_differs: differs,
+            counted_path_explained: 0,
             agreements: vec![
                 classify_against(REFERENCES[0], &pw.reference, false),
                 classify_against(REFERENCES[1], &pr.robust, false),
@@ -164,7 +166,8 @@ impl Checker<'_> {
             self.opts.threads,
         )?;
         let mesh = &refs.run.scene.scene.mesh;
-        let paths = counted_path_differences(mesh, &rays, &timed, &counted, &self.tol);
+        let paths =
+            counted_path_differences(mesh, &rays, &timed, &counted, &self.tol, subject.accel);
         let differs = paths.differs;
         let classify_against =
             |reference: (&str, &dyn Accel), theirs: &Answers, on_sample: bool| {
@@ -194,7 +197,7 @@ impl Checker<'_> {
                     reference_name: reference.0,
                 };
                 check_against(
-                    mesh, &rays, &ours, &theirs, &sides, &self.tol, indices, differs,
+                    mesh, &rays, &ours, &theirs, &sides, &self.tol, indices, paths,
                 )
             };
         let agreements = vec![
@@ -214,6 +217,7 @@ impl Checker<'_> {
             queries: rays.len(),
             subsampled: subject.sampled,
             counted_path_differs: differs,
+            counted_path_explained: paths.explained,
             agreements,
         };
         Ok((result, timed))
@@ -239,7 +243,7 @@ fn check_against(
     sides: &Sides<'_>,
     tol: &Tolerance,
     indices: Option<&[usize]>,
-    counted_path_differs: u64,
+    paths: PathDifferences,
 ) -> Agreement {
     let (mut v, _levels) = check_answers(mesh, rays, ours, theirs, sides, tol);
     if let Some(idx) = indices {
@@ -247,7 +251,8 @@ fn check_against(
             d.index = idx[d.index];
         }
     }
-    v.counted_path_differs = counted_path_differs;
+    v.counted_path_differs = paths.differs;
+    v.counted_path_explained = paths.explained;
     v
 }
 
