@@ -39,7 +39,12 @@ pub fn physical_memory() -> u64 {
 }
 
 fn gib(bytes: f64) -> String {
-    format!("{:.1} GiB", bytes / (1u64 << 30) as f64)
+    let g = bytes / (1u64 << 30) as f64;
+    if g < 1e6 {
+        format!("{g:.1} GiB")
+    } else {
+        format!("{g:.1e} GiB")
+    }
 }
 
 /// Refuses `--rays n` when the ray workloads would not fit in memory. `ray_workloads` counts
@@ -50,13 +55,12 @@ pub fn check_rays(n: usize, ray_workloads: usize, whitted: bool) -> Result<()> {
     }
     let held = ray_workloads as u64 + if whitted { WHITTED_FACTOR - 1 } else { 0 };
     let per_ray = held * BYTES_PER_RAY_HELD + BYTES_PER_RAY_TRACED;
-    check_count(
-        "--rays",
-        "ray",
-        n,
-        per_ray,
-        &format!("{held} ray workload(s)"),
-    )
+    let what = match (ray_workloads, whitted) {
+        (1, _) => "1 ray workload".to_string(),
+        (n, false) => format!("{n} ray workloads"),
+        (n, true) => format!("{n} ray workloads, Whitted's counted {WHITTED_FACTOR} times"),
+    };
+    check_count("--rays", "ray", n, per_ray, &what)
 }
 
 /// Refuses `--points n` when the closest-point workloads would not fit in memory.
@@ -65,7 +69,10 @@ pub fn check_points(n: usize, point_workloads: usize) -> Result<()> {
         return Ok(());
     }
     let per_point = (point_workloads as u64 + 1) * BYTES_PER_POINT;
-    let what = format!("{point_workloads} closest-point workload(s)");
+    let what = match point_workloads {
+        1 => "1 closest-point workload".to_string(),
+        n => format!("{n} closest-point workloads"),
+    };
     check_count("--points", "query point", n, per_point, &what)
 }
 
@@ -74,8 +81,8 @@ fn check_count(flag: &str, unit: &str, n: usize, per_item: u64, what: &str) -> R
     let allowed = (memory as f64 * MEMORY_SHARE / per_item as f64) as u64;
     if n as u64 > allowed {
         bail!(
-            "{flag} {n} is more than this machine can hold: {what} need about {per_item} bytes \
-             a {unit} ({} in all) and a run may plan on half of its {} of memory; at most \
+            "{flag} {n} is more than this machine can hold: at about {per_item} bytes a {unit} \
+             ({what}) that is {}, and a run may plan on half of its {} of memory; at most \
              {allowed} here",
             gib(n as f64 * per_item as f64),
             gib(memory as f64)
@@ -174,7 +181,7 @@ mod tests {
         let err = check_rays(usize::MAX, 5, true).unwrap_err().to_string();
         assert!(err.starts_with("--rays 18446744073709551615 is more than this machine can hold"));
         assert!(
-            err.contains("8 ray workload(s) need about 1280 bytes a ray"),
+            err.contains("about 1280 bytes a ray (5 ray workloads, Whitted's counted 4 times)"),
             "{err}"
         );
         assert!(
