@@ -59,10 +59,6 @@ pub struct KdParams {
     /// A node with at most this many triangles is a leaf without trying any split. The SAH
     /// builder also stops whenever no split is cheaper than intersecting every triangle.
     pub leaf_size: u32,
-    /// Guard against reference blow-up (huge triangles, many straddlers): once the build has
-    /// made this many references per triangle, the remaining nodes become leaves. Not a tuning
-    /// knob: on the bunny, Sponza, conference and dragon the SAH tree stays far below it.
-    pub max_refs_per_triangle: f32,
     /// Record tested triangles in a small per-ray table so a triangle referenced by several
     /// leaves is tested once (skips are counted as `mailbox_skips`).
     pub mailbox: bool,
@@ -70,8 +66,8 @@ pub struct KdParams {
     /// the root only: a handful of tasks per worker thread).
     pub parallel_threshold: u32,
     /// The build refuses with [`BuildError::TooLarge`] when the memory it needs before the
-    /// first reference (triangle copies, event scratch) exceeds this, and otherwise lowers the
-    /// reference budget so references fit within it.
+    /// first reference (triangle copies, event scratch) exceeds this, and otherwise gives the
+    /// tree only as many references as fit within it (see `build::Share`).
     pub memory_limit_bytes: u64,
 }
 
@@ -99,7 +95,6 @@ impl KdParams {
             empty_bonus: 0.8,
             max_depth: None,
             leaf_size: 0,
-            max_refs_per_triangle: 32.0,
             mailbox: true,
             parallel_threshold: 16_384,
             memory_limit_bytes: KdParams::MEMORY_LIMIT,
@@ -193,12 +188,10 @@ impl Accel for KdTree {
         if !(ok(params.traversal_cost)
             && params.intersection_cost.is_finite()
             && params.intersection_cost > 0.0
-            && ok(params.empty_bonus)
-            && params.max_refs_per_triangle >= 1.0)
+            && ok(params.empty_bonus))
         {
             return Err(BuildError::Unsupported(format!(
-                "costs must be finite and non-negative, intersection_cost > 0, \
-                 max_refs_per_triangle >= 1 (got {params:?})"
+                "costs must be finite and non-negative and intersection_cost > 0 (got {params:?})"
             )));
         }
         let mut tree = KdTree::from_flat(&mesh, params, Selection::Hittable)?;

@@ -36,15 +36,14 @@ fn extreme_knobs_conform() {
         ..KdParams::sah()
     });
     // Splitting always pays (free traversal, no empty bonus): deep trees, tiny leaves, many
-    // duplicated references, up to the reference budget.
+    // duplicated references, down to the depth limit.
     check(KdParams {
         traversal_cost: 0.0,
         empty_bonus: 1.0,
-        max_refs_per_triangle: 4.0,
         ..KdParams::sah()
     });
-    // Aggressive empty-space cutting and a tight reference budget on the median tree, with
-    // leaves of one triangle and a deep limit.
+    // Aggressive empty-space cutting, and the median tree with leaves of one triangle and a
+    // deep limit.
     check(KdParams {
         empty_bonus: 0.1,
         ..KdParams::sah()
@@ -52,7 +51,6 @@ fn extreme_knobs_conform() {
     check(KdParams {
         leaf_size: 1,
         max_depth: Some(40),
-        max_refs_per_triangle: 1.5,
         ..KdParams::median()
     });
 }
@@ -77,7 +75,7 @@ fn point_queries_conform() {
             mailbox: false,
             ..KdParams::sah()
         },
-        // One leaf holding everything, and deep trees with tiny leaves up to the budget.
+        // One leaf holding everything, and deep trees with tiny leaves.
         KdParams {
             max_depth: Some(0),
             ..KdParams::sah()
@@ -85,7 +83,6 @@ fn point_queries_conform() {
         KdParams {
             traversal_cost: 0.0,
             empty_bonus: 1.0,
-            max_refs_per_triangle: 4.0,
             ..KdParams::sah()
         },
     ] {
@@ -106,8 +103,8 @@ fn point_queries_conform_on_the_shared_scenes() {
 }
 
 /// A scene too large for the memory limit is refused before the build allocates anything; a
-/// limit that fits the triangles but few references caps the reference budget instead, and
-/// the tree is still correct.
+/// limit that fits the triangles but few references caps the tree's references instead (and
+/// says so in the statistics), and the tree is still correct.
 #[test]
 fn too_large_is_an_error_not_an_abort() {
     use raybench_accel::Accel;
@@ -122,7 +119,9 @@ fn too_large_is_an_error_not_an_abort() {
         memory_limit_bytes: 2000 * 116 + 3000 * 108,
         ..KdParams::sah()
     };
-    let tree = KdTree::build(mesh.clone(), &tight).expect("builds within the budget");
+    let tree = KdTree::build(mesh.clone(), &tight).expect("builds within the limit");
     tree.validate(&mesh).expect("valid");
-    assert!(tree.build_stats().refs <= 3000, "{:?}", tree.build_stats());
+    let stats = tree.build_stats();
+    assert!(stats.refs <= 3000, "{stats:?}");
+    assert!(stats.extra["memory_capped_leaves"] > 0.0, "{stats:?}");
 }

@@ -1,5 +1,5 @@
 //! k-d tree construction, shared by both builders: the depth-first output (nodes written in
-//! place, one reference array), the depth limit, the reference budget, the statistics and the
+//! place, one reference array), the depth limit, the memory guard, the statistics and the
 //! final reordering of triangles into leaf order.
 //!
 //! * [`sah`]: Wald and Havran's O(N log N) SAH builder with perfect splits.
@@ -9,10 +9,13 @@
 //! one rule of [`crate::clip::side`]. Termination and degenerate input are handled the same
 //! way in both: a split plane always lies strictly inside its cell (so no child is ever flat
 //! on the split axis, and a flat root cell is never split on its flat axis), the depth is
-//! capped ([`KdParams::max_depth`], at most [`MAX_DEPTH`]), and a build-wide reference budget
-//! ([`KdParams::max_refs_per_triangle`]) turns the remaining nodes into leaves once it is
-//! spent, so neither recursion nor memory can grow without bound, whatever the input (huge
-//! triangles spanning the scene, thousands of triangles in one plane or at one point).
+//! capped ([`KdParams::max_depth`], at most [`MAX_DEPTH`]), and each subtree holds at most its
+//! [`Share`] of the references the memory limit allows, so neither recursion nor memory can
+//! grow without bound, whatever the input (huge triangles spanning the scene, thousands of
+//! triangles in one plane or at one point). Within those guards the SAH builder stops where
+//! its cost model says a leaf is cheaper than any split, which already charges a split for
+//! every reference it duplicates; no global count of references decides which nodes may
+//! split, so a leaf built late is as fine as one built early.
 //!
 //! Triangles whose precomputed normal is exactly zero in f32 can never be hit (Möller–Trumbore
 //! rejects `den == 0`), so they are left out of the tree and counted in the statistics
@@ -29,7 +32,6 @@ use crate::{Builder, KdParams};
 use raybench_accel::{BuildError, BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use raybench_geom::{Aabb, MollerTriangle, Triangle, TriangleMesh, Vec3};
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicI64, Ordering};
 
 /// Havran's default depth limit, `round(8 + 1.3 log2 N)` (Havran 2000, §4.5), within
 /// [`MAX_DEPTH`].
@@ -44,28 +46,74 @@ pub(crate) struct Ctx<'a> {
     pub params: &'a KdParams,
     pub max_depth: u32,
     pub root_area: f64,
-    /// References still allowed beyond one per triangle (see [`Ctx::take_budget`]).
-    budget: AtomicI64,
     /// Nodes above this depth may build their subtrees on two rayon tasks.
     pub fork_depth: u32,
 }
 
 impl Ctx<'_> {
-    /// Reserves `extra` more references for a split; false (and nothing reserved) when the
-    /// budget cannot cover them. Relaxed atomics: when the budget runs out during a parallel
-    /// build, which nodes got the last of it depends on scheduling; until then the tree is
-    /// deterministic.
-    pub fn take_budget(&self, extra: usize) -> bool {
-        let extra = extra as i64;
-        if self.budget.load(Ordering::Relaxed) < extra {
-            return false;
-        }
-        self.budget.fetch_sub(extra, Ordering::Relaxed) >= extra
-    }
-
     pub fn fork(&self, n: usize, depth: u32) -> bool {
         depth < self.fork_depth && n > self.params.parallel_threshold as usize
     }
+}
+
+/// The references a subtree may hold, so the whole tree fits in
+/// [`KdParams::memory_limit_bytes`] whatever the input. The root gets what the memory allows. A
+/// split needs its two children's references within its node's share; the children then
+/// divide the share. Near the root (depth below [`Share::PROPORTIONAL_DEPTH`], where subtrees
+/// may be built in parallel) they divide it in proportion to their references; deeper, the
+/// child below the plane is built first with the share minus what the child above needs at
+/// least, and the child above gets what the first left. Either way no subtree can exceed its
+/// share, and a node's share depends only on the tree built before it in depth-first order,
+/// never on the thread count or the order threads finish in, so the tree is deterministic. It
+/// is a memory guard, not a tuning knob: a node it stops is counted (`memory_capped_leaves`);
+/// the cost model decides where splitting stops.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Share(pub u64);
+
+impl Share {
+    /// Above this depth the share is divided in proportion and subtrees may fork.
+    pub const PROPORTIONAL_DEPTH: u32 = 6;
+
+    /// Whether a split into `below` and `above` references fits.
+    pub fn fits(self, below: usize, above: usize) -> bool {
+        below as u64 + above as u64 <= self.0
+    }
+
+    /// The children's shares in proportion to their references (the split fits).
+    pub fn proportional(self, below: usize, above: usize) -> (Share, Share) {
+        let (b, a) = (below as u128, above as u128);
+        // u128: the share times a count may exceed u64.
+        let sb = (self.0 as u128 * b / (b + a).max(1)) as u64;
+        (Share(sb), Share(self.0 - sb))
+    }
+}
+
+/// A leaf with more triangles than this is a termination failure unless the triangles' bounds
+/// share a point (a pile of triangles through one point, which planes cannot cut apart near
+/// it); both kinds are counted.
+pub const LARGE_LEAF: usize = 64;
+
+/// Whether the bounds of the triangles `ids` have a point in common (what triangles through one
+/// point have; bounds are the cheap, conservative test).
+fn bounds_share_a_point(tris: &[Triangle], ids: &[u32]) -> bool {
+    let (lo, hi) = ids
+        .iter()
+        .fold((Vec3::NEG_INFINITY, Vec3::INFINITY), |(lo, hi), &i| {
+            let b = tris[i as usize].bounds();
+            (lo.max(b.min), hi.min(b.max))
+        });
+    lo.cmple(hi).all()
+}
+
+/// Why a node became a leaf, for the statistics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Stop {
+    /// The cost model (or the leaf size) chose a leaf: the normal case.
+    Cost,
+    /// The depth limit.
+    Depth,
+    /// The node's reference share ([`Share`]) could not cover the split the cost chose.
+    Memory,
 }
 
 /// Shape facts gathered while nodes are written.
@@ -74,10 +122,15 @@ pub(crate) struct Shape {
     interior: u64,
     leaves: u64,
     empty_leaves: u64,
-    refs: u64,
+    pub refs: u64,
     max_depth: u32,
     leaf_depth_sum: u64,
     max_leaf_size: u32,
+    depth_capped: u64,
+    memory_capped: u64,
+    /// Leaves over [`LARGE_LEAF`] triangles: all of them, and those whose bounds share a point.
+    large: u64,
+    large_piles: u64,
     /// Σ area(cell)/area(root) × cost, see [`Out::leaf`] and [`Out::interior`].
     sah: f64,
 }
@@ -91,6 +144,10 @@ impl Shape {
         self.max_depth = self.max_depth.max(o.max_depth);
         self.leaf_depth_sum += o.leaf_depth_sum;
         self.max_leaf_size = self.max_leaf_size.max(o.max_leaf_size);
+        self.depth_capped += o.depth_capped;
+        self.memory_capped += o.memory_capped;
+        self.large += o.large;
+        self.large_piles += o.large_piles;
         self.sah += o.sah;
     }
 }
@@ -107,8 +164,8 @@ pub(crate) struct Out {
 
 impl Out {
     /// Writes a leaf holding `ids` (sorted, so leaves are deterministic whatever order the
-    /// builder collected them in).
-    pub fn leaf(&mut self, ctx: &Ctx, cell: &Aabb, depth: u32, mut ids: Vec<u32>) {
+    /// builder collected them in). `stop` says why it is a leaf.
+    pub fn leaf(&mut self, ctx: &Ctx, cell: &Aabb, depth: u32, mut ids: Vec<u32>, stop: Stop) {
         ids.sort_unstable();
         let count = ids.len() as u32;
         self.nodes
@@ -121,6 +178,12 @@ impl Out {
         s.max_depth = s.max_depth.max(depth);
         s.leaf_depth_sum += depth as u64;
         s.max_leaf_size = s.max_leaf_size.max(count);
+        s.depth_capped += (stop == Stop::Depth) as u64;
+        s.memory_capped += (stop == Stop::Memory) as u64;
+        if count as usize > LARGE_LEAF {
+            s.large += 1;
+            s.large_piles += bounds_share_a_point(ctx.tris, &ids) as u64;
+        }
         if ctx.root_area > 0.0 {
             s.sah += cell.surface_area() / ctx.root_area * count as f64 * SAH_INTERSECTION_COST;
         }
@@ -194,7 +257,7 @@ pub(crate) fn build(
     params: &KdParams,
     selection: Selection,
 ) -> Result<Flat, BuildError> {
-    let affordable_refs = reference_budget_within_memory(mesh.len(), params)?;
+    let affordable_refs = references_within_memory(mesh.len(), params)?;
     let tris: Vec<Triangle> = mesh.triangles().collect();
     let ids: Vec<u32> = (0..tris.len() as u32)
         .filter(|&i| selection.holds(&tris[i as usize]))
@@ -214,19 +277,18 @@ pub(crate) fn build(
         .max_depth
         .unwrap_or_else(|| default_max_depth(n))
         .min(MAX_DEPTH as u32);
-    let max_refs = (n as f64 * params.max_refs_per_triangle as f64)
-        .min(u32::MAX as f64 / 2.0)
-        .min(affordable_refs as f64);
+    // The packed node holds 30-bit reference offsets; leave room below that.
+    let share = Share(affordable_refs.min(u32::MAX as u64 / 2));
     let threads = rayon::current_num_threads();
     let ctx = Ctx {
         tris: &tris,
         params,
         max_depth: depth_limit,
         root_area: bounds.surface_area(),
-        budget: AtomicI64::new(max_refs as i64 - n as i64),
-        // A few tasks per worker (2^fork_depth ≥ 4 × threads), none with one thread.
+        // A few tasks per worker (2^fork_depth ≥ 4 × threads), none with one thread, and
+        // only where the reference share is divided in proportion.
         fork_depth: if threads > 1 {
-            (usize::BITS - (threads - 1).leading_zeros()) + 2
+            ((usize::BITS - (threads - 1).leading_zeros()) + 2).min(Share::PROPORTIONAL_DEPTH)
         } else {
             0
         },
@@ -234,8 +296,8 @@ pub(crate) fn build(
     let mut out = Out::default();
     if n > 0 {
         match params.builder {
-            Builder::Sah => sah::build(&ctx, &ids, &bounds, &mut out),
-            Builder::Median => median::build(&ctx, &ids, &bounds, &mut out),
+            Builder::Sah => sah::build(&ctx, &ids, &bounds, share, &mut out),
+            Builder::Median => median::build(&ctx, &ids, &bounds, share, &mut out),
         }
     }
     if out.nodes.len() > MAX_PACKED as usize || out.shape.max_leaf_size >= MAX_PACKED {
@@ -295,6 +357,13 @@ fn stats(s: &Shape, n: usize, excluded: usize, depth_limit: u32, root_area: f64)
     extra.insert("max_leaf_size".into(), s.max_leaf_size as f64);
     extra.insert("depth_limit".into(), depth_limit as f64);
     extra.insert("excluded_degenerate".into(), excluded as f64);
+    extra.insert("depth_capped_leaves".into(), s.depth_capped as f64);
+    extra.insert("memory_capped_leaves".into(), s.memory_capped as f64);
+    extra.insert(format!("leaves_over_{LARGE_LEAF}"), s.large as f64);
+    extra.insert(
+        format!("leaves_over_{LARGE_LEAF}_sharing_a_point"),
+        s.large_piles as f64,
+    );
     BuildStats {
         // Interior nodes plus leaves, as every structure counts them.
         nodes: s.interior + s.leaves,
@@ -314,8 +383,9 @@ const FIXED_BYTES_PER_TRIANGLE: u64 = 36 + 48 + 4 + 4 + 24;
 const BYTES_PER_REF: u64 = 6 * 8 * 2 + 4 + 8;
 
 /// The most references the build may make within `params.memory_limit_bytes`, estimated before
-/// allocating anything; `TooLarge` when not even one reference per triangle fits.
-fn reference_budget_within_memory(n: usize, params: &KdParams) -> Result<u64, BuildError> {
+/// allocating anything (the root's [`Share`]); `TooLarge` when not even one reference per
+/// triangle fits.
+fn references_within_memory(n: usize, params: &KdParams) -> Result<u64, BuildError> {
     let n = n as u64;
     let fixed = n * FIXED_BYTES_PER_TRIANGLE;
     let affordable = params.memory_limit_bytes.saturating_sub(fixed) / BYTES_PER_REF;

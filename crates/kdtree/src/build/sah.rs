@@ -22,7 +22,7 @@
 //! assumptions (uniform rays, no early termination) reward cutting off empty space, which
 //! `λ` makes explicit; it is a knob, not a law.
 
-use super::{Ctx, Out};
+use super::{Ctx, Out, Share, Stop};
 use crate::KdParams;
 use crate::clip::{halves, straddler_bounds};
 use raybench_geom::Aabb;
@@ -34,7 +34,7 @@ use events::{
     unord,
 };
 
-pub(crate) fn build(ctx: &Ctx, ids: &[u32], root: &Aabb, out: &mut Out) {
+pub(crate) fn build(ctx: &Ctx, ids: &[u32], root: &Aabb, share: Share, out: &mut Out) {
     let mut ev: Events = Default::default();
     for list in ev.iter_mut() {
         list.reserve(2 * ids.len());
@@ -44,7 +44,7 @@ pub(crate) fn build(ctx: &Ctx, ids: &[u32], root: &Aabb, out: &mut Out) {
     }
     ev.par_iter_mut().for_each(radix_sort);
     let mut scratch = Scratch::new(ctx.tris.len());
-    node(ctx, ev, ids.len(), *root, 0, &mut scratch, out);
+    node(ctx, ev, ids.len(), *root, 0, share, &mut scratch, out);
 }
 
 /// Per-task working memory, reused by every node the task builds: the side table indexed by
@@ -81,55 +81,97 @@ pub(crate) struct Split {
 }
 
 /// One node: a leaf, or the best split and both subtrees. `ev` holds the events of the node's
-/// `n` triangles clipped to `cell`; `scratch` is the task's working memory.
+/// `n` triangles clipped to `cell`; `share` bounds the references of the subtree;
+/// `scratch` is the task's working memory.
+#[allow(clippy::too_many_arguments)]
 fn node(
     ctx: &Ctx,
     ev: Events,
     n: usize,
     cell: Aabb,
     depth: u32,
+    share: Share,
     scratch: &mut Scratch,
     out: &mut Out,
 ) {
     let p = ctx.params;
-    let split = if n <= p.leaf_size as usize || depth >= ctx.max_depth {
-        None
+    let chosen = if n <= p.leaf_size as usize {
+        Err(Stop::Cost)
+    } else if depth >= ctx.max_depth {
+        Err(Stop::Depth)
     } else {
         best_split(&ev, n, &cell, p)
+            .filter(|s| s.cost < p.intersection_cost as f64 * n as f64)
+            .ok_or(Stop::Cost)
+            .and_then(|s| {
+                if share.fits(s.n_below, s.n_above) {
+                    Ok(s)
+                } else {
+                    Err(Stop::Memory)
+                }
+            })
     };
-    let split = split.filter(|s| {
-        s.cost < p.intersection_cost as f64 * n as f64 && ctx.take_budget(s.n_below + s.n_above - n)
-    });
-    let Some(s) = split else {
-        let ids = ev[0]
-            .iter()
-            .filter(|&&e| kind_of(e) != END)
-            .map(|&e| tri_of(e))
-            .collect();
-        out.leaf(ctx, &cell, depth, ids);
-        return;
+    let s = match chosen {
+        Ok(s) => s,
+        Err(stop) => {
+            let ids = ev[0]
+                .iter()
+                .filter(|&&e| kind_of(e) != END)
+                .map(|&e| tri_of(e))
+                .collect();
+            out.leaf(ctx, &cell, depth, ids, stop);
+            return;
+        }
     };
     let (cb, ca) = halves(&cell, s.axis, s.pos);
     let (evb, nb, eva, na) = split_events(ctx, ev, &s, &cb, &ca, scratch);
     debug_assert_eq!((nb, na), (s.n_below, s.n_above), "sweep and split agree");
     let at = out.open_interior(ctx, &cell);
-    let above_at = if ctx.fork(n, depth) {
-        let ((), sub) = rayon::join(
-            || node(ctx, evb, nb, cb, depth + 1, scratch, out),
-            || {
-                let mut sub = Out::default();
-                let mut own = Scratch::new(ctx.tris.len());
-                node(ctx, eva, na, ca, depth + 1, &mut own, &mut sub);
-                sub
-            },
-        );
-        let above_at = out.nodes.len();
-        out.append(sub);
-        above_at
+    let above_at = if depth < Share::PROPORTIONAL_DEPTH {
+        let (share_b, share_a) = share.proportional(nb, na);
+        if ctx.fork(n, depth) {
+            let ((), sub) = rayon::join(
+                || node(ctx, evb, nb, cb, depth + 1, share_b, scratch, out),
+                || {
+                    let mut sub = Out::default();
+                    let mut own = Scratch::new(ctx.tris.len());
+                    node(ctx, eva, na, ca, depth + 1, share_a, &mut own, &mut sub);
+                    sub
+                },
+            );
+            let above_at = out.nodes.len();
+            out.append(sub);
+            above_at
+        } else {
+            node(ctx, evb, nb, cb, depth + 1, share_b, scratch, out);
+            let above_at = out.nodes.len();
+            node(ctx, eva, na, ca, depth + 1, share_a, scratch, out);
+            above_at
+        }
     } else {
-        node(ctx, evb, nb, cb, depth + 1, scratch, out);
+        let before = out.shape.refs;
+        node(
+            ctx,
+            evb,
+            nb,
+            cb,
+            depth + 1,
+            Share(share.0 - na as u64),
+            scratch,
+            out,
+        );
+        let used = out.shape.refs - before;
         let above_at = out.nodes.len();
-        node(ctx, eva, na, ca, depth + 1, scratch, out);
+        node(
+            ctx,
+            eva,
+            na,
+            ca,
+            depth + 1,
+            Share(share.0 - used),
+            scratch,
+            out,
+        );
         above_at
     };
     out.close_interior(at, s.axis, s.pos, above_at);
@@ -431,17 +473,16 @@ mod tests {
             }
             let s = fast.unwrap();
             // The event split against classifying every triangle directly.
-            let budget_ctx = Ctx {
+            let ctx = Ctx {
                 tris: &tris,
                 params: &p,
                 max_depth: 30,
                 root_area: 1.0,
-                budget: std::sync::atomic::AtomicI64::new(0),
                 fork_depth: 0,
             };
             let (cb, ca) = halves(&cell, s.axis, s.pos);
             let mut scratch = Scratch::new(tris.len());
-            let (evb, nb, eva, na) = split_events(&budget_ctx, ev, &s, &cb, &ca, &mut scratch);
+            let (evb, nb, eva, na) = split_events(&ctx, ev, &s, &cb, &ca, &mut scratch);
             assert_eq!((nb, na), (s.n_below, s.n_above), "round {round}");
             let mut want_b: Events = Default::default();
             let mut want_a: Events = Default::default();
