@@ -26,7 +26,7 @@ pub use node::{MAX_DEPTH, Node};
 
 use build::Selection;
 use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, Walk};
-use raybench_geom::{Aabb, MollerTriangle, Ray, TriangleMesh, Vec3};
+use raybench_geom::{Aabb, Ray, Tri4, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -126,16 +126,20 @@ impl KdParams {
     }
 }
 
-/// A flattened k-d tree: nodes depth-first, one reference array, triangles in the order leaves
-/// first reference them (Embree's precomputed layout) and each one's index in the mesh.
+/// A flattened k-d tree: nodes depth-first, one reference array with each leaf padded to a
+/// multiple of four, and beside it the leaves' triangles four to a [`Tri4`] in Embree's
+/// precomputed layout (`build/pack.rs`).
 #[derive(Debug)]
 pub struct KdTree {
     name: String,
     params: KdParams,
     nodes: Vec<Node>,
-    /// Leaf contents: indices into `triangles`, each leaf a contiguous range.
+    /// Leaf contents: slots (`prim_ids[slot]` is the mesh index), each leaf a contiguous range
+    /// starting at a multiple of four and padded with `build::pack::PAD`.
     refs: Vec<u32>,
-    triangles: Vec<MollerTriangle>,
+    /// The triangles of `refs`, lane for lane: reference `r` is lane `r % 4` of Tri4 `r / 4`,
+    /// with the mesh index as its id.
+    tri4s: Vec<Tri4>,
     prim_ids: Vec<u32>,
     /// The root cell: the bounds of every referenced triangle.
     bounds: Aabb,
@@ -221,7 +225,7 @@ impl Accel for KdTree {
             nodes: std::mem::size_of_val(self.nodes.as_slice()) as u64,
             indices: (std::mem::size_of_val(self.refs.as_slice())
                 + std::mem::size_of_val(self.prim_ids.as_slice())) as u64,
-            primitives: std::mem::size_of_val(self.triangles.as_slice()) as u64,
+            primitives: std::mem::size_of_val(self.tri4s.as_slice()) as u64,
         };
         match &self.zero_area {
             None => own,
@@ -250,7 +254,7 @@ impl KdTree {
             params: params.clone(),
             nodes: flat.nodes,
             refs: flat.refs,
-            triangles: flat.triangles,
+            tri4s: flat.tri4s,
             prim_ids: flat.prim_ids,
             bounds: flat.bounds,
             depth_limit: flat.depth_limit,

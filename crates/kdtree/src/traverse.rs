@@ -32,15 +32,20 @@
 //! count when `t_min < t <= t_max` (Möller–Trumbore's own depth test); any hit (`occluded`)
 //! returns at the first triangle that reports one.
 //!
-//! Mailbox: a direct-mapped table of [`MAILBOX_SLOTS`] triangle indices on the stack, indexed
-//! by the low bits of the index. A collision only evicts (the evicted triangle may be tested
-//! again), so it is never wrong; triangles are numbered in leaf order, so the triangles of
-//! neighbouring leaves fall in different slots. Nothing is allocated per ray and `&self` is
-//! shared freely between threads.
+//! Leaves: a leaf's triangles are its own copies, four to a `Tri4` (`build/pack.rs`), tested
+//! four at a time with the same arithmetic as the scalar Möller–Trumbore test, so each lane's
+//! answer is bit for bit the scalar one; among lanes that hit, the nearest wins (the lowest lane
+//! on ties). Padding lanes are masked off and never counted.
+//!
+//! Mailbox: a direct-mapped table of [`MAILBOX_SLOTS`] mesh indices on the stack, indexed by
+//! the low bits of the index; a lane whose triangle was tested before is masked off before the
+//! test. A collision only evicts (the evicted triangle may be tested again), so it is never
+//! wrong. Nothing is allocated per ray and `&self` is shared freely between threads.
 
 use crate::KdTree;
 use crate::node::MAX_DEPTH;
 use raybench_accel::{CounterSink, Hit};
+use raybench_geom::tri4::LANES;
 use raybench_geom::{Ray, TriHit, max_keep, min_keep};
 
 /// Mailbox size, a power of two. 8 slots are 32 bytes, two stores per ray; 16 compile their
@@ -113,16 +118,31 @@ impl KdTree {
                 node = self.nodes[at as usize];
             }
             c.leaf();
-            let first = node.first() as usize;
-            for &r in &self.refs[first..first + node.count() as usize] {
-                if MAILBOX && mailbox.seen(r) {
-                    c.mailbox_skip();
-                    continue;
+            // The leaf's Tri4s: four references each, the last one padded.
+            let (first, count) = (node.first() as usize, node.count() as usize);
+            for (q, four) in self.tri4s[first / LANES..(first + count).div_ceil(LANES)]
+                .iter()
+                .enumerate()
+            {
+                let mut lanes = LANE_MASKS[(count - q * LANES).min(LANES)];
+                if MAILBOX {
+                    for l in 0..LANES {
+                        if lanes >> l & 1 == 1 && mailbox.seen(four.ids[l]) {
+                            lanes &= !(1 << l);
+                            c.mailbox_skip();
+                        }
+                    }
+                    if lanes == 0 {
+                        continue;
+                    }
                 }
-                c.prim_tests(1);
-                if let Some(h) = self.triangles[r as usize].intersect(&ray.with_t_max(best_t)) {
+                c.prim_tests(lanes.count_ones() as u64);
+                let hits = four.test(ray, best_t);
+                let hit = hits.mask & lanes;
+                if hit != 0 {
+                    let (l, h) = hits.nearest(hit);
                     best_t = h.t;
-                    best = Some((r, h));
+                    best = Some((four.ids[l], h));
                     if ANY_HIT {
                         break 'walk;
                     }
@@ -143,9 +163,12 @@ impl KdTree {
                 break;
             }
         }
-        best.map(|(r, h)| Hit::from_tri_hit(self.prim_ids[r as usize], h))
+        best.map(|(prim, h)| Hit::from_tri_hit(prim, h))
     }
 }
+
+/// The lanes in use of a Tri4 holding `i` references (`i` ≤ 4).
+const LANE_MASKS: [u32; LANES + 1] = [0, 0b1, 0b11, 0b111, 0b1111];
 
 /// Stack entries for trees at most this deep (see [`KdTree::trace`]).
 pub(crate) const SMALL_STACK: usize = 32;

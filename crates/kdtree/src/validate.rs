@@ -26,9 +26,11 @@
 
 use crate::KdTree;
 use crate::build::Selection;
+use crate::build::pack::PAD;
 use crate::clip::{Side, halves, side, straddler_bounds};
 use crate::node::{LEAF, MAX_DEPTH, Node};
-use raybench_geom::{Aabb, MollerTriangle, Triangle, TriangleMesh};
+use raybench_geom::tri4::{LANES, NO_PRIM};
+use raybench_geom::{Aabb, MollerTriangle, Tri4, Triangle, TriangleMesh};
 
 pub(crate) fn validate(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
     validate_tree(kd, mesh)?;
@@ -48,9 +50,6 @@ fn validate_tree(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
     let n = mesh.len();
     // Stored triangles: a subset of the mesh without repeats, matching it, and holding every
     // triangle of the tree's selection (those a ray can hit, or the zero-area ones).
-    if kd.triangles.len() != kd.prim_ids.len() {
-        return Err("triangles and prim_ids differ in length".into());
-    }
     let mut slot_of = vec![u32::MAX; n];
     for (i, &id) in kd.prim_ids.iter().enumerate() {
         let s = slot_of
@@ -60,9 +59,13 @@ fn validate_tree(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
             return Err(format!("prim id {id} appears twice"));
         }
         *s = i as u32;
-        if kd.triangles[i] != MollerTriangle::new(&mesh.triangle(id as usize)) {
-            return Err(format!("triangle slot {i} is not mesh triangle {id}"));
-        }
+    }
+    if kd.tri4s.len() * LANES != kd.refs.len() {
+        return Err(format!(
+            "{} Tri4s for {} references",
+            kd.tri4s.len(),
+            kd.refs.len()
+        ));
     }
     let selected: Vec<u32> = (0..n as u32)
         .filter(|&i| kd.selection.holds(&mesh.triangle(i as usize)))
@@ -125,7 +128,7 @@ fn validate_tree(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
         if in_leaf.windows(2).any(|w| w[0] == w[1]) {
             return Err(format!("leaf {at} references a triangle twice"));
         }
-        if let Some(&bad) = in_leaf.iter().find(|&&r| r as usize >= kd.triangles.len()) {
+        if let Some(&bad) = in_leaf.iter().find(|&&r| r as usize >= kd.prim_ids.len()) {
             return Err(format!("leaf {at} references slot {bad} out of range"));
         }
         actual.extend(in_leaf.into_iter().map(|r| (at as u32, r)));
@@ -152,6 +155,37 @@ fn validate_tree(kd: &KdTree, mesh: &TriangleMesh) -> Result<(), String> {
             "leaf {} references triangle {} whose clipped bounds do not reach it",
             extra.0, kd.prim_ids[extra.1 as usize]
         ));
+    }
+    for &(at, _) in &leaves {
+        leaf_copies(kd, mesh, at)?;
+    }
+    Ok(())
+}
+
+/// The leaf's Tri4 lanes: its `count` references as exact copies of their mesh triangles with
+/// the mesh index as id, then padding references and unused lanes to a multiple of four.
+fn leaf_copies(kd: &KdTree, mesh: &TriangleMesh, at: usize) -> Result<(), String> {
+    let (first, count) = (kd.nodes[at].first() as usize, kd.nodes[at].count() as usize);
+    for j in first..first + count.next_multiple_of(LANES) {
+        let (four, lane) = (&kd.tri4s[j / LANES], j % LANES);
+        let r = kd.refs[j];
+        if j >= first + count {
+            if r != PAD || four.ids[lane] != NO_PRIM || four.lane(lane) != Tri4::default().lane(0) {
+                return Err(format!("leaf {at}: padding reference {j} is not empty"));
+            }
+            continue;
+        }
+        let Some(&id) = kd.prim_ids.get(r as usize) else {
+            return Err(format!("leaf {at} references slot {r} out of range"));
+        };
+        if four.ids[lane] != id
+            || four.lane(lane) != MollerTriangle::new(&mesh.triangle(id as usize))
+        {
+            return Err(format!(
+                "leaf {at}: lane {lane} of Tri4 {} is not mesh triangle {id}",
+                j / LANES
+            ));
+        }
     }
     Ok(())
 }
@@ -189,10 +223,11 @@ fn structure(
                 node.first()
             ));
         }
-        *next_ref += node.count() as usize;
+        *next_ref += (node.count() as usize).next_multiple_of(LANES);
         if *next_ref > kd.refs.len() {
             return Err(format!("leaf {at} runs past the references"));
         }
+
         leaves.push((at, *cell));
         return Ok(());
     }
@@ -338,7 +373,7 @@ mod tests {
         let (mut kd, mesh) = built(KdParams::sah());
         let leaf = kd.nodes[first_full_leaf(&kd)];
         let f = leaf.first() as usize;
-        let elsewhere = (0..kd.triangles.len() as u32)
+        let elsewhere = (0..kd.prim_ids.len() as u32)
             .find(|r| !kd.refs[f..f + leaf.count() as usize].contains(r))
             .unwrap();
         kd.refs[f] = elsewhere;
@@ -361,12 +396,22 @@ mod tests {
     #[test]
     fn a_wrong_triangle_is_caught() {
         let (mut kd, mesh) = built(KdParams::sah());
-        kd.triangles.swap(0, 1);
+        kd.tri4s.swap(0, 1);
         assert!(
             kd.validate(&mesh)
                 .unwrap_err()
                 .contains("is not mesh triangle")
         );
+        // A padding lane that holds a triangle.
+        let (mut kd, mesh) = built(KdParams::sah());
+        let at = (0..kd.nodes.len())
+            .find(|&i| kd.nodes[i].is_leaf() && kd.nodes[i].count() % 4 != 0)
+            .expect("a leaf with padding");
+        let (f, c) = (kd.nodes[at].first() as usize, kd.nodes[at].count() as usize);
+        let j = f + c;
+        let copy = kd.tri4s[f / 4].lane(0);
+        kd.tri4s[j / 4].set_lane(j % 4, 0, &copy);
+        assert!(kd.validate(&mesh).unwrap_err().contains("padding"));
     }
 
     #[test]

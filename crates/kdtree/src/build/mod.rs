@@ -25,12 +25,13 @@
 //! and a scene full of them (conference: 54k of 331k) does not make point queries linear.
 
 pub mod median;
+pub(crate) mod pack;
 pub mod sah;
 
 use crate::node::{MAX_DEPTH, MAX_PACKED, Node};
 use crate::{Builder, KdParams};
 use raybench_accel::{BuildError, BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
-use raybench_geom::{Aabb, MollerTriangle, Triangle, TriangleMesh, Vec3};
+use raybench_geom::{Aabb, MollerTriangle, Tri4, Triangle, TriangleMesh, Vec3};
 use std::collections::BTreeMap;
 
 /// Havran's default depth limit, `round(8 + 1.3 log2 N)` (Havran 2000, §4.5), within
@@ -224,7 +225,7 @@ impl Out {
 pub(crate) struct Flat {
     pub nodes: Vec<Node>,
     pub refs: Vec<u32>,
-    pub triangles: Vec<MollerTriangle>,
+    pub tri4s: Vec<Tri4>,
     pub prim_ids: Vec<u32>,
     pub bounds: Aabb,
     pub depth_limit: u32,
@@ -307,28 +308,13 @@ pub(crate) fn build(
             out.shape.max_leaf_size
         )));
     }
-    // Triangles in the order leaves first reference them: a leaf's triangles sit together in
-    // memory, and neighbouring leaves mostly share theirs.
-    let mut new_id = vec![u32::MAX; tris.len()];
-    let mut prim_ids = Vec::with_capacity(n);
-    for r in out.refs.iter_mut() {
-        let slot = &mut new_id[*r as usize];
-        if *slot == u32::MAX {
-            *slot = prim_ids.len() as u32;
-            prim_ids.push(*r);
-        }
-        *r = *slot;
-    }
-    let triangles = prim_ids
-        .iter()
-        .map(|&i| MollerTriangle::new(&tris[i as usize]))
-        .collect();
     let stats = stats(&out.shape, n, excluded, depth_limit, bounds.surface_area());
+    let packed = pack::pack(out.nodes, &out.refs, &tris);
     Ok(Flat {
-        nodes: out.nodes,
-        refs: out.refs,
-        triangles,
-        prim_ids,
+        nodes: packed.nodes,
+        refs: packed.refs,
+        tri4s: packed.tri4s,
+        prim_ids: packed.prim_ids,
         bounds,
         depth_limit,
         stats,
