@@ -13,11 +13,13 @@
 //!   closest-point queries.
 //! * [`SplitMix64`]: the one small seeded generator of the workspace.
 //!
-//! No `unsafe`, no acceleration structures.
-#![forbid(unsafe_code)]
+//! No acceleration structures, and no `unsafe` outside the AVX-512 packet kernel (`packet`).
+#![deny(unsafe_code)] // allowed only in the AVX-512 packet kernel, `packet.rs`
 
 mod aabb;
 mod mesh;
+#[cfg(target_arch = "x86_64")]
+pub mod packet;
 mod point;
 mod ray;
 pub mod rng;

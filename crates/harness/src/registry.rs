@@ -162,9 +162,15 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<KdTree>(
             "kd-sah",
-            "k-d tree, SAH with perfect splits in O(N log N) (Wald–Havran 2006), early exit, mailbox",
+            "k-d tree, SAH with perfect splits in O(N log N) (Wald–Havran 2006), termination by cost, leaves of Tri4 copies tested 4 lanes at a time, early exit, mailbox",
             None,
             |_| KdParams::sah(),
+        ),
+        register::<KdTree>(
+            "kd-packets",
+            "the kd-sah tree; coherent batches (primary rays) traced sixteen rays a packet, one per AVX-512 lane (Wald 2004), every other batch ray by ray as kd-sah",
+            None,
+            |_| KdParams::packets(),
         ),
         register::<KdTree>(
             "kd-median",

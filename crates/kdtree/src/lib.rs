@@ -13,11 +13,14 @@
 //! |---|---|---|
 //! | `kd-sah` | SAH with perfect splits, event sweep, O(N log N) | Wald and Havran 2006 |
 //! | `kd-median` | spatial median, round-robin axes | the textbook baseline |
-#![forbid(unsafe_code)]
+//! | `kd-packets` | `kd-sah`, coherent batches walked sixteen rays at a time (`packets.rs`) | Wald 2004 |
+#![deny(unsafe_code)] // allowed only in the AVX-512 packet walk, `packets.rs`
 
 pub mod build;
 pub mod clip;
 mod node;
+#[cfg(target_arch = "x86_64")]
+mod packets;
 mod points;
 mod traverse;
 mod validate;
@@ -25,8 +28,10 @@ mod validate;
 pub use node::{MAX_DEPTH, Node};
 
 use build::Selection;
-use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, Walk};
-use raybench_geom::{Aabb, Ray, Tri4, TriangleMesh, Vec3};
+use raybench_accel::{
+    Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, PreparedRays, Walk,
+};
+use raybench_geom::{Aabb, Ray, RayError, Tri4, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -59,6 +64,10 @@ pub struct KdParams {
     /// A node with at most this many triangles is a leaf without trying any split. The SAH
     /// builder also stops whenever no split is cheaper than intersecting every triangle.
     pub leaf_size: u32,
+    /// Trace coherent batches (`Accel::prepare_coherent_rays`: camera rays in scanline order)
+    /// as packets of sixteen rays on CPUs with AVX-512F; other batches, any-hit queries and
+    /// other CPUs take the single-ray walk.
+    pub packets: bool,
     /// Record tested triangles in a small per-ray table so a triangle referenced by several
     /// leaves is tested once (skips are counted as `mailbox_skips`).
     pub mailbox: bool,
@@ -95,6 +104,7 @@ impl KdParams {
             empty_bonus: 0.8,
             max_depth: None,
             leaf_size: 0,
+            packets: false,
             mailbox: true,
             parallel_threshold: 16_384,
             memory_limit_bytes: KdParams::MEMORY_LIMIT,
@@ -112,11 +122,21 @@ impl KdParams {
         }
     }
 
+    /// `kd-packets`: `kd-sah` with coherent batches traced as packets.
+    pub fn packets() -> KdParams {
+        KdParams {
+            packets: true,
+            ..KdParams::sah()
+        }
+    }
+
     /// The registered name of this configuration.
     pub fn name(&self) -> String {
-        let base = match self.builder {
-            Builder::Sah => "kd-sah",
-            Builder::Median => "kd-median",
+        let base = match (self.builder, self.packets) {
+            (Builder::Sah, true) => "kd-packets",
+            (Builder::Sah, false) => "kd-sah",
+            (Builder::Median, true) => "kd-median-packets",
+            (Builder::Median, false) => "kd-median",
         };
         if self.mailbox {
             base.to_string()
@@ -154,6 +174,9 @@ pub struct KdTree {
     /// The zero-area triangles rays never hit, in a tree of their own that only closest-point
     /// queries walk (`None` when the mesh has none; see [`build`]).
     zero_area: Option<Box<KdTree>>,
+    /// Set when coherent batches are traced as packets (`packets` and AVX-512F detected).
+    #[cfg(target_arch = "x86_64")]
+    coherent: Option<raybench_geom::packet::Avx512Packets>,
 }
 
 impl KdTree {
@@ -175,6 +198,14 @@ impl KdTree {
 
     pub fn bounds(&self) -> &Aabb {
         &self.bounds
+    }
+
+    /// Whether coherent batches are traced as packets (`packets` set and AVX-512F present).
+    pub fn packet_walk(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return self.coherent.is_some();
+        #[cfg(not(target_arch = "x86_64"))]
+        false
     }
 
     /// Checks the invariants (see `validate.rs`): structure, split planes inside their cells,
@@ -217,6 +248,34 @@ impl Accel for KdTree {
 
     fn build_stats(&self) -> BuildStats {
         self.stats.clone()
+    }
+
+    fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
+        #[cfg(target_arch = "x86_64")]
+        if self.coherent.is_some() {
+            let packets = raybench_geom::packet::RayPackets::new(rays);
+            return Ok(PreparedRays::Foreign(Box::new(packets)));
+        }
+        self.prepare_rays(rays)
+    }
+
+    fn intersect_prepared(
+        &self,
+        rays: &[Ray],
+        prepared: &PreparedRays,
+        first: usize,
+        out: &mut [Option<Hit>],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if let (Some(k), PreparedRays::Foreign(any)) = (self.coherent, prepared)
+            && let Some(packets) = any.downcast_ref::<raybench_geom::packet::RayPackets>()
+            && let Some(blocks) = packets.range(first, out.len())
+        {
+            return packets::intersect_coherent(k, self, &rays[first..], blocks, out);
+        }
+        for (o, ray) in out.iter_mut().zip(&rays[first..]) {
+            *o = self.intersect(ray);
+        }
     }
 
     /// Both trees; the mesh the point queries read vertices from is the caller's, not counted.
@@ -262,6 +321,11 @@ impl KdTree {
             selection,
             mesh: mesh.clone(),
             zero_area: None,
+            #[cfg(target_arch = "x86_64")]
+            coherent: params
+                .packets
+                .then(raybench_geom::packet::Avx512Packets::detect)
+                .flatten(),
         })
     }
 }

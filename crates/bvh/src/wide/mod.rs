@@ -80,7 +80,7 @@ pub struct BvhWide<const W: usize> {
     avx2: Option<avx2::Avx2Nodes>,
     /// The packet walk for coherent batches, when asked for and the CPU has AVX-512F.
     #[cfg(target_arch = "x86_64")]
-    coherent: Option<packets::Avx512Packets>,
+    coherent: Option<raybench_geom::packet::Avx512Packets>,
 }
 
 /// 8 children per node, tested in one AVX2 pass per axis: the structure that races Embree.
@@ -189,7 +189,7 @@ impl<const W: usize> Accel for BvhWide<W> {
             #[cfg(target_arch = "x86_64")]
             coherent: params
                 .coherent_packets
-                .then(packets::Avx512Packets::detect)
+                .then(raybench_geom::packet::Avx512Packets::detect)
                 .flatten(),
         })
     }
@@ -213,7 +213,7 @@ impl<const W: usize> Accel for BvhWide<W> {
     fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
         #[cfg(target_arch = "x86_64")]
         if self.coherent.is_some() {
-            let packets = packets::RayPackets::new(rays);
+            let packets = raybench_geom::packet::RayPackets::new(rays);
             return Ok(PreparedRays::Foreign(Box::new(packets)));
         }
         Ok(PreparedRays::Native)
@@ -228,7 +228,7 @@ impl<const W: usize> Accel for BvhWide<W> {
     ) {
         #[cfg(target_arch = "x86_64")]
         if let (Some(k), PreparedRays::Foreign(any)) = (self.coherent, prepared)
-            && let Some(packets) = any.downcast_ref::<packets::RayPackets>()
+            && let Some(packets) = any.downcast_ref::<raybench_geom::packet::RayPackets>()
             && let Some(packets) = packets.range(first, out.len())
         {
             return packets::intersect_coherent(k, self, packets, out);

@@ -32,115 +32,11 @@
 //! when that is beyond every active ray's closest hit so far.
 
 use crate::node::ChildRef;
-use crate::simd::F4;
 use crate::wide::{BvhWide, STACK};
 use raybench_accel::Hit;
-use raybench_geom::Ray;
-use raybench_geom::{NO_PRIM, Tri4};
+use raybench_geom::NO_PRIM;
+use raybench_geom::packet::{self, Avx512Packets, Best, PACKET, Packet, RayBlock};
 use std::arch::x86_64::*;
-
-/// Rays in a packet: one per AVX-512 lane.
-pub(crate) const PACKET: usize = 16;
-
-/// Proof that this CPU runs AVX-512F (the only way to reach the packet code).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Avx512Packets(());
-
-impl Avx512Packets {
-    pub(crate) fn detect() -> Option<Avx512Packets> {
-        std::arch::is_x86_feature_detected!("avx512f").then_some(Avx512Packets(()))
-    }
-}
-
-/// Up to sixteen rays in structure-of-arrays form.
-struct Packet {
-    origin: [__m512; 3],
-    dir: [__m512; 3],
-    inv: [__m512; 3],
-    t_min: __m512,
-}
-
-/// Each lane's closest hit so far.
-struct Best {
-    t: __m512,
-    u: __m512,
-    v: __m512,
-    prim: __m512i,
-}
-
-/// Rays `16 k ..` of a coherent batch in structure-of-arrays form, made outside timing by
-/// `prepare_coherent_rays`: rows `origin x, y, z`, `dir x, y, z`, `inv_dir x, y, z`, `t_min`,
-/// `t_max`, one lane per ray (lanes past the batch's end are copies of its last ray, never
-/// reported).
-#[derive(Clone, Debug)]
-#[repr(C, align(64))]
-pub(crate) struct RayBlock {
-    rows: [[f32; PACKET]; 11],
-}
-
-/// A coherent batch as blocks of [`PACKET`] rays.
-#[derive(Clone, Debug)]
-pub(crate) struct RayPackets {
-    blocks: Vec<RayBlock>,
-    len: usize,
-}
-
-impl RayPackets {
-    pub(crate) fn new(rays: &[Ray]) -> RayPackets {
-        let blocks = rays
-            .chunks(PACKET)
-            .map(|chunk| {
-                let mut rows = [[0.0f32; PACKET]; 11];
-                for lane in 0..PACKET {
-                    let ray = &chunk[lane.min(chunk.len() - 1)];
-                    let (o, d, inv) = (ray.origin(), ray.dir(), ray.inv_dir());
-                    for a in 0..3 {
-                        rows[a][lane] = o[a];
-                        rows[3 + a][lane] = d[a];
-                        rows[6 + a][lane] = inv[a];
-                    }
-                    rows[9][lane] = ray.t_min();
-                    rows[10][lane] = ray.t_max();
-                }
-                RayBlock { rows }
-            })
-            .collect();
-        RayPackets {
-            blocks,
-            len: rays.len(),
-        }
-    }
-
-    /// The blocks of rays `first .. first + len`, when `first` starts a block (the harness's
-    /// chunks are multiples of [`PACKET`]); `None` otherwise, and the caller walks ray by ray.
-    pub(crate) fn range(&self, first: usize, len: usize) -> Option<&[RayBlock]> {
-        let end = first.checked_add(len)?;
-        (first.is_multiple_of(PACKET) && end <= self.len)
-            .then(|| &self.blocks[first / PACKET..end.div_ceil(PACKET)])
-    }
-}
-
-/// A block loaded into a packet, with its closest-hit windows' far ends as the best hits so
-/// far.
-#[target_feature(enable = "avx512f")]
-fn load_packet(block: &RayBlock) -> (Packet, Best) {
-    // SAFETY: each row is 16 initialised f32s, 64-byte aligned (the block is aligned to 64
-    // and every row is 64 bytes long).
-    let load = |row: usize| unsafe { _mm512_load_ps(block.rows[row].as_ptr()) };
-    let packet = Packet {
-        origin: [load(0), load(1), load(2)],
-        dir: [load(3), load(4), load(5)],
-        inv: [load(6), load(7), load(8)],
-        t_min: load(9),
-    };
-    let best = Best {
-        t: load(10),
-        u: _mm512_setzero_ps(),
-        v: _mm512_setzero_ps(),
-        prim: _mm512_set1_epi32(NO_PRIM as i32),
-    };
-    (packet, best)
-}
 
 /// A subtree still to visit: its reference, the smallest entry distance among the lanes that
 /// entered its box, and those lanes.
@@ -174,58 +70,15 @@ fn intersect_packets<const W: usize>(
     stack: &mut PacketStack,
 ) {
     for (block, out) in blocks.iter().zip(out.chunks_mut(PACKET)) {
-        let (packet, mut best) = load_packet(block);
+        let (packet, mut best) = packet::load(block);
         if !bvh.tri4s().is_empty() {
-            // Bit `a` of a lane's octant: axis `a` points down (`-0` too: its inverse is -inf).
-            let zero = _mm512_setzero_ps();
-            let down = packet
-                .inv
-                .map(|inv| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(inv, zero));
-            let mut left: u16 = if out.len() >= PACKET {
-                u16::MAX
-            } else {
-                (1 << out.len()) - 1
-            };
-            while left != 0 {
-                let lane = left.trailing_zeros();
-                let octant = (0..3).fold(0u8, |o, a| o | (((down[a] >> lane) & 1) as u8) << a);
-                let lanes = (0..3).fold(left, |m, a| {
-                    m & if octant >> a & 1 == 1 {
-                        down[a]
-                    } else {
-                        !down[a]
-                    }
-                });
-                walk(bvh, &packet, lanes, octant, &mut best, stack);
-                left &= !lanes;
-            }
+            packet::octant_groups(&packet, out.len(), |lanes, octant| {
+                walk(bvh, &packet, lanes, octant, &mut best, stack)
+            });
         }
-        store_hits(&best, out);
-    }
-}
-
-/// Each lane's hit as the single-ray walk reports it.
-#[target_feature(enable = "avx512f")]
-fn store_hits(best: &Best, out: &mut [Option<Hit>]) {
-    let mut t = [0.0f32; PACKET];
-    let mut u = [0.0f32; PACKET];
-    let mut v = [0.0f32; PACKET];
-    let mut prim = [0u32; PACKET];
-    // SAFETY: each destination is 16 writable 4-byte values; `storeu` has no alignment
-    // requirement.
-    unsafe {
-        _mm512_storeu_ps(t.as_mut_ptr(), best.t);
-        _mm512_storeu_ps(u.as_mut_ptr(), best.u);
-        _mm512_storeu_ps(v.as_mut_ptr(), best.v);
-        _mm512_storeu_si512(prim.as_mut_ptr().cast(), best.prim);
-    }
-    for (lane, o) in out.iter_mut().enumerate() {
-        *o = (prim[lane] != NO_PRIM).then_some(Hit {
-            t: t[lane],
-            prim: prim[lane],
-            u: u[lane],
-            v: v[lane],
-        });
+        for (o, (prim, h)) in out.iter_mut().zip(best.hits()) {
+            *o = (prim != NO_PRIM).then(|| Hit::from_tri_hit(prim, h));
+        }
     }
 }
 
@@ -249,7 +102,10 @@ fn walk<const W: usize>(
     let mut lanes = active;
     'walk: loop {
         if r.is_leaf() {
-            leaf(bvh, r, p, lanes, best);
+            let first = r.index as usize;
+            for tri4 in &bvh.tri4s()[first..first + (r.count as usize).div_ceil(4)] {
+                best.test_tri4(tri4, p, lanes);
+            }
             farthest = _mm512_mask_reduce_max_ps(active, best.t);
         } else {
             let n = &bvh.nodes()[r.index as usize];
@@ -308,89 +164,4 @@ fn push_sorted(stack: &mut PacketStack, base: usize, sp: &mut usize, e: Entry) {
     }
     stack[j] = e;
     *sp += 1;
-}
-
-/// `a × b` lane-wise in glam's order, as [`raybench_geom::Tri4::test`].
-#[target_feature(enable = "avx512f")]
-#[inline]
-fn cross(a: &[__m512; 3], b: &[__m512; 3]) -> [__m512; 3] {
-    [
-        _mm512_sub_ps(_mm512_mul_ps(a[1], b[2]), _mm512_mul_ps(b[1], a[2])),
-        _mm512_sub_ps(_mm512_mul_ps(a[2], b[0]), _mm512_mul_ps(b[2], a[0])),
-        _mm512_sub_ps(_mm512_mul_ps(a[0], b[1]), _mm512_mul_ps(b[0], a[1])),
-    ]
-}
-
-/// `a · b` lane-wise in glam's order, `(ax bx + ay by) + az bz`.
-#[target_feature(enable = "avx512f")]
-#[inline]
-fn dot(a: &[__m512; 3], b: &[__m512; 3]) -> __m512 {
-    _mm512_add_ps(
-        _mm512_add_ps(_mm512_mul_ps(a[0], b[0]), _mm512_mul_ps(a[1], b[1])),
-        _mm512_mul_ps(a[2], b[2]),
-    )
-}
-
-/// `x` negated in the lanes where `by` has its sign bit set (`-0` counts as negative).
-#[target_feature(enable = "avx512f")]
-#[inline]
-fn flip(x: __m512, by: __m512) -> __m512 {
-    let sign = _mm512_and_si512(_mm512_castps_si512(by), _mm512_set1_epi32(i32::MIN));
-    _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(x), sign))
-}
-
-/// Every triangle of leaf `r` against the `active` lanes, one triangle a pass.
-#[target_feature(enable = "avx512f")]
-fn leaf<const W: usize>(bvh: &BvhWide<W>, r: ChildRef, p: &Packet, active: u16, best: &mut Best) {
-    let first = r.index as usize;
-    let tri4s = &bvh.tri4s()[first..first + (r.count as usize).div_ceil(4)];
-    for tri4 in tri4s {
-        // The four normals `e2 × e1` in one 4-lane pass (the same operations as the 16-lane
-        // `cross`, so the same bits), broadcast per triangle below.
-        let ng4 = normals(tri4);
-        for lane in 0..4 {
-            let id = tri4.ids[lane];
-            if id == NO_PRIM {
-                break;
-            }
-            let at = |v: &[[f32; 4]; 3]| [0, 1, 2].map(|a| _mm512_set1_ps(v[a][lane]));
-            let (v0, e1, e2, ng) = (at(&tri4.v0), at(&tri4.e1), at(&tri4.e2), at(&ng4));
-            let c = [0, 1, 2].map(|a| _mm512_sub_ps(v0[a], p.origin[a]));
-            let rr = cross(&c, &p.dir);
-            let den = dot(&ng, &p.dir);
-            let abs_den = _mm512_abs_ps(den);
-            let u = flip(dot(&rr, &e2), den);
-            let v = flip(dot(&rr, &e1), den);
-            let zero = _mm512_setzero_ps();
-            let mut hit = _mm512_mask_cmp_ps_mask::<_CMP_NEQ_UQ>(active, den, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, u, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, v, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, _mm512_add_ps(u, v), abs_den);
-            if hit == 0 {
-                continue;
-            }
-            let t = flip(dot(&ng, &c), den);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(hit, _mm512_mul_ps(abs_den, p.t_min), t);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, t, _mm512_mul_ps(abs_den, best.t));
-            if hit == 0 {
-                continue;
-            }
-            let inv = _mm512_div_ps(_mm512_set1_ps(1.0), abs_den);
-            best.t = _mm512_mask_mov_ps(best.t, hit, _mm512_mul_ps(t, inv));
-            best.u = _mm512_mask_mov_ps(best.u, hit, _mm512_mul_ps(u, inv));
-            best.v = _mm512_mask_mov_ps(best.v, hit, _mm512_mul_ps(v, inv));
-            best.prim = _mm512_mask_mov_epi32(best.prim, hit, _mm512_set1_epi32(id as i32));
-        }
-    }
-}
-
-/// `e2 × e1` of a `Tri4`'s four triangles, per axis, in glam's order.
-#[inline(always)]
-fn normals(t: &Tri4) -> [[f32; 4]; 3] {
-    let (e1, e2) = (t.e1.map(|r| F4::load(&r)), t.e2.map(|r| F4::load(&r)));
-    [
-        e2[1].mul(e1[2]).sub(e1[1].mul(e2[2])).to_array(),
-        e2[2].mul(e1[0]).sub(e1[2].mul(e2[0])).to_array(),
-        e2[0].mul(e1[1]).sub(e1[0].mul(e2[1])).to_array(),
-    ]
 }

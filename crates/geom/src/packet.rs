@@ -1,0 +1,277 @@
+//! Packets of sixteen coherent rays, one ray per AVX-512 lane: the pieces every packet walk
+//! shares, whatever structure it walks (the wide BVH's `bvh8-packets`, the k-d tree's
+//! `kd-packets`). A walk decides which nodes and leaves a packet visits; this module holds the
+//! rays' layout ([`RayPackets`], made outside timing), their loading into registers
+//! ([`load`]), the test of one [`Tri4`]'s triangles against the active lanes
+//! ([`Best::test_tri4`]), the split of a packet into lanes of one direction octant
+//! ([`octant_groups`]) and the answers' return ([`Best::hits`]).
+//!
+//! Exactness: each lane computes what the single-ray Möller–Trumbore test computes for its ray,
+//! operation for operation (the products and sums of [`Tri4::test`] in the same order, no
+//! fused multiply-add), so each ray's hit, `t`, `u` and `v` are bit for bit the single-ray
+//! test's. Only the order in which a walk meets triangles may differ from its single-ray walk,
+//! so on an exact tie (two triangles at the same `t`) the reported triangle may be the other.
+//!
+//! The intrinsics are reached only through [`Avx512Packets`], which exists only after runtime
+//! detection saw AVX-512F; the rest of the crate stays free of `unsafe`.
+#![allow(unsafe_code)]
+
+use crate::{NO_PRIM, Ray, Tri4, TriHit};
+use std::arch::x86_64::*;
+
+/// Rays in a packet: one per AVX-512 lane.
+pub const PACKET: usize = 16;
+
+/// Proof that this CPU runs AVX-512F (the only way to reach the packet code).
+#[derive(Clone, Copy, Debug)]
+pub struct Avx512Packets(());
+
+impl Avx512Packets {
+    pub fn detect() -> Option<Avx512Packets> {
+        std::arch::is_x86_feature_detected!("avx512f").then_some(Avx512Packets(()))
+    }
+}
+
+/// Up to sixteen rays in structure-of-arrays form.
+#[derive(Debug)]
+pub struct Packet {
+    pub origin: [__m512; 3],
+    pub dir: [__m512; 3],
+    pub inv: [__m512; 3],
+    pub t_min: __m512,
+}
+
+/// Each lane's closest hit so far.
+#[derive(Debug)]
+pub struct Best {
+    pub t: __m512,
+    pub u: __m512,
+    pub v: __m512,
+    pub prim: __m512i,
+}
+
+/// Rays `16 k ..` of a coherent batch in structure-of-arrays form: rows `origin x, y, z`,
+/// `dir x, y, z`, `inv_dir x, y, z`, `t_min`, `t_max`, one lane per ray (lanes past the batch's
+/// end are copies of its last ray, never reported).
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+pub struct RayBlock {
+    rows: [[f32; PACKET]; 11],
+}
+
+/// A coherent batch as blocks of [`PACKET`] rays.
+#[derive(Clone, Debug)]
+pub struct RayPackets {
+    blocks: Vec<RayBlock>,
+    len: usize,
+}
+
+impl RayPackets {
+    pub fn new(rays: &[Ray]) -> RayPackets {
+        let blocks = rays
+            .chunks(PACKET)
+            .map(|chunk| {
+                let mut rows = [[0.0f32; PACKET]; 11];
+                for lane in 0..PACKET {
+                    let ray = &chunk[lane.min(chunk.len() - 1)];
+                    let (o, d, inv) = (ray.origin(), ray.dir(), ray.inv_dir());
+                    for a in 0..3 {
+                        rows[a][lane] = o[a];
+                        rows[3 + a][lane] = d[a];
+                        rows[6 + a][lane] = inv[a];
+                    }
+                    rows[9][lane] = ray.t_min();
+                    rows[10][lane] = ray.t_max();
+                }
+                RayBlock { rows }
+            })
+            .collect();
+        RayPackets {
+            blocks,
+            len: rays.len(),
+        }
+    }
+
+    /// The blocks of rays `first .. first + len`, when `first` starts a block (the harness's
+    /// chunks are multiples of [`PACKET`]); `None` otherwise, and the caller walks ray by ray.
+    pub fn range(&self, first: usize, len: usize) -> Option<&[RayBlock]> {
+        let end = first.checked_add(len)?;
+        (first.is_multiple_of(PACKET) && end <= self.len)
+            .then(|| &self.blocks[first / PACKET..end.div_ceil(PACKET)])
+    }
+}
+
+/// A block loaded into a packet, with its closest-hit windows' far ends as the best hits so
+/// far.
+///
+/// # Safety
+///
+/// AVX-512F must be available: call it from code reached through an [`Avx512Packets`].
+#[target_feature(enable = "avx512f")]
+pub fn load(block: &RayBlock) -> (Packet, Best) {
+    // SAFETY: each row is 16 initialised f32s, 64-byte aligned (the block is aligned to 64
+    // and every row is 64 bytes long).
+    let load = |row: usize| unsafe { _mm512_load_ps(block.rows[row].as_ptr()) };
+    let packet = Packet {
+        origin: [load(0), load(1), load(2)],
+        dir: [load(3), load(4), load(5)],
+        inv: [load(6), load(7), load(8)],
+        t_min: load(9),
+    };
+    let best = Best {
+        t: load(10),
+        u: _mm512_setzero_ps(),
+        v: _mm512_setzero_ps(),
+        prim: _mm512_set1_epi32(NO_PRIM as i32),
+    };
+    (packet, best)
+}
+
+/// The lanes of the first `len` rays, split by direction octant: calls `walk(lanes, octant)`
+/// once per octant present, bit `a` of `octant` set when axis `a` points down (`-0` too: its
+/// inverse is -inf). A walk that orders children by the direction's signs needs one octant.
+///
+/// # Safety
+///
+/// AVX-512F must be available: call it from code reached through an [`Avx512Packets`].
+#[target_feature(enable = "avx512f")]
+pub fn octant_groups(p: &Packet, len: usize, mut walk: impl FnMut(u16, u8)) {
+    let zero = _mm512_setzero_ps();
+    let down = p.inv.map(|inv| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(inv, zero));
+    let mut left: u16 = if len >= PACKET {
+        u16::MAX
+    } else {
+        (1 << len) - 1
+    };
+    while left != 0 {
+        let lane = left.trailing_zeros();
+        let octant = (0..3).fold(0u8, |o, a| o | (((down[a] >> lane) & 1) as u8) << a);
+        let lanes = (0..3).fold(left, |m, a| {
+            m & if octant >> a & 1 == 1 {
+                down[a]
+            } else {
+                !down[a]
+            }
+        });
+        walk(lanes, octant);
+        left &= !lanes;
+    }
+}
+
+impl Best {
+    /// Each lane's hit as the single-ray walk reports it: the triangle's id ([`NO_PRIM`] for
+    /// none) and the hit.
+    ///
+    /// # Safety
+    ///
+    /// AVX-512F must be available: call it from code reached through an [`Avx512Packets`].
+    #[target_feature(enable = "avx512f")]
+    pub fn hits(&self) -> [(u32, TriHit); PACKET] {
+        let mut t = [0.0f32; PACKET];
+        let mut u = [0.0f32; PACKET];
+        let mut v = [0.0f32; PACKET];
+        let mut prim = [0u32; PACKET];
+        // SAFETY: each destination is 16 writable 4-byte values; `storeu` has no alignment
+        // requirement.
+        unsafe {
+            _mm512_storeu_ps(t.as_mut_ptr(), self.t);
+            _mm512_storeu_ps(u.as_mut_ptr(), self.u);
+            _mm512_storeu_ps(v.as_mut_ptr(), self.v);
+            _mm512_storeu_si512(prim.as_mut_ptr().cast(), self.prim);
+        }
+        std::array::from_fn(|l| {
+            let hit = TriHit {
+                t: t[l],
+                u: u[l],
+                v: v[l],
+            };
+            (prim[l], hit)
+        })
+    }
+
+    /// Every triangle of `tri4` against the `active` lanes, one triangle a pass; a lane's hit
+    /// replaces its best when `t_min < t <= best`.
+    ///
+    /// # Safety
+    ///
+    /// AVX-512F must be available: call it from code reached through an [`Avx512Packets`].
+    #[target_feature(enable = "avx512f")]
+    pub fn test_tri4(&mut self, tri4: &Tri4, p: &Packet, active: u16) {
+        // The four normals `e2 × e1` in one pass (the same operations as `cross`, so the same
+        // bits), broadcast per triangle below.
+        let ng4 = normals(tri4);
+        for lane in 0..4 {
+            let id = tri4.ids[lane];
+            if id == NO_PRIM {
+                break;
+            }
+            let at = |v: &[[f32; 4]; 3]| [0, 1, 2].map(|a| _mm512_set1_ps(v[a][lane]));
+            let (v0, e1, e2, ng) = (at(&tri4.v0), at(&tri4.e1), at(&tri4.e2), at(&ng4));
+            let c = [0, 1, 2].map(|a| _mm512_sub_ps(v0[a], p.origin[a]));
+            let rr = cross(&c, &p.dir);
+            let den = dot(&ng, &p.dir);
+            let abs_den = _mm512_abs_ps(den);
+            let u = flip(dot(&rr, &e2), den);
+            let v = flip(dot(&rr, &e1), den);
+            let zero = _mm512_setzero_ps();
+            let mut hit = _mm512_mask_cmp_ps_mask::<_CMP_NEQ_UQ>(active, den, zero);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, u, zero);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, v, zero);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, _mm512_add_ps(u, v), abs_den);
+            if hit == 0 {
+                continue;
+            }
+            let t = flip(dot(&ng, &c), den);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(hit, _mm512_mul_ps(abs_den, p.t_min), t);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, t, _mm512_mul_ps(abs_den, self.t));
+            if hit == 0 {
+                continue;
+            }
+            let inv = _mm512_div_ps(_mm512_set1_ps(1.0), abs_den);
+            self.t = _mm512_mask_mov_ps(self.t, hit, _mm512_mul_ps(t, inv));
+            self.u = _mm512_mask_mov_ps(self.u, hit, _mm512_mul_ps(u, inv));
+            self.v = _mm512_mask_mov_ps(self.v, hit, _mm512_mul_ps(v, inv));
+            self.prim = _mm512_mask_mov_epi32(self.prim, hit, _mm512_set1_epi32(id as i32));
+        }
+    }
+}
+
+/// `a × b` lane-wise in glam's order, as [`Tri4::test`].
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn cross(a: &[__m512; 3], b: &[__m512; 3]) -> [__m512; 3] {
+    [
+        _mm512_sub_ps(_mm512_mul_ps(a[1], b[2]), _mm512_mul_ps(b[1], a[2])),
+        _mm512_sub_ps(_mm512_mul_ps(a[2], b[0]), _mm512_mul_ps(b[2], a[0])),
+        _mm512_sub_ps(_mm512_mul_ps(a[0], b[1]), _mm512_mul_ps(b[0], a[1])),
+    ]
+}
+
+/// `a · b` lane-wise in glam's order, `(ax bx + ay by) + az bz`.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn dot(a: &[__m512; 3], b: &[__m512; 3]) -> __m512 {
+    _mm512_add_ps(
+        _mm512_add_ps(_mm512_mul_ps(a[0], b[0]), _mm512_mul_ps(a[1], b[1])),
+        _mm512_mul_ps(a[2], b[2]),
+    )
+}
+
+/// `x` negated in the lanes where `by` has its sign bit set (`-0` counts as negative).
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn flip(x: __m512, by: __m512) -> __m512 {
+    let sign = _mm512_and_si512(_mm512_castps_si512(by), _mm512_set1_epi32(i32::MIN));
+    _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(x), sign))
+}
+
+/// `e2 × e1` of a `Tri4`'s four triangles, per axis, in glam's order.
+#[inline(always)]
+fn normals(t: &Tri4) -> [[f32; 4]; 3] {
+    let (e1, e2) = (&t.e1, &t.e2);
+    [
+        std::array::from_fn(|l| e2[1][l] * e1[2][l] - e1[1][l] * e2[2][l]),
+        std::array::from_fn(|l| e2[2][l] * e1[0][l] - e1[2][l] * e2[0][l]),
+        std::array::from_fn(|l| e2[0][l] * e1[1][l] - e1[0][l] * e2[1][l]),
+    ]
+}
