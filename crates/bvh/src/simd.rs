@@ -196,23 +196,7 @@ mod imp {
 
 pub(crate) use imp::F4;
 
-/// Asks the cache for the 64-byte lines of the `T` at `p`, without waiting for them: the
-/// wide walk calls it for every child it will visit, so the fetch of a pushed subtree overlaps
-/// the work on the current one (as Embree's traversal does). A hint only: it never faults, and
-/// does nothing where there is no prefetch instruction.
-#[inline(always)]
-pub(crate) fn prefetch<T>(p: *const T) {
-    #[cfg(target_arch = "x86_64")]
-    for k in 0..std::mem::size_of::<T>().div_ceil(64) {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        // `wrapping_add` keeps the address computation defined even past the allocation.
-        let line = p.cast::<i8>().wrapping_add(64 * k);
-        // SAFETY: prefetch is a hint that never dereferences or faults, and SSE is baseline.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>(line) };
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = p;
-}
+pub(crate) use raybench_geom::prefetch;
 
 #[cfg(test)]
 mod tests {

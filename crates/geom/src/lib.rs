@@ -13,14 +13,16 @@
 //!   closest-point queries.
 //! * [`SplitMix64`]: the one small seeded generator of the workspace.
 //!
-//! No acceleration structures, and no `unsafe` outside the AVX-512 packet kernel (`packet`).
-#![deny(unsafe_code)] // allowed only in the AVX-512 packet kernel, `packet.rs`
+//! No acceleration structures, and no `unsafe` outside the AVX-512 packet kernel (`packet`) and
+//! the cache hint (`prefetch`).
+#![deny(unsafe_code)] // allowed only in the AVX-512 packet kernel and the cache hint
 
 mod aabb;
 mod mesh;
 #[cfg(target_arch = "x86_64")]
 pub mod packet;
 mod point;
+mod prefetch;
 mod ray;
 pub mod rng;
 pub mod tri4;
@@ -33,6 +35,7 @@ pub use mesh::{MeshError, RemovedTriangles, TriangleMesh};
 pub use point::{
     box_distance_squared, closest_point_on_triangle, distance_to_triangle_f64, query_radius_squared,
 };
+pub use prefetch::prefetch;
 pub use ray::{EMBREE_LARGE, Ray, RayError};
 pub use rng::SplitMix64;
 pub use tri4::{NO_PRIM, Tri4, Tri4Hits};

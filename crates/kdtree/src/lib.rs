@@ -90,17 +90,22 @@ impl KdParams {
     /// 8 GiB: a third of this VM's memory, as the grid and octree use.
     pub const MEMORY_LIMIT: u64 = 8 << 30;
 
-    /// `kd-sah`. `K_I / K_T = 0.75`, against 0.5, 1, 1.5 (about Wald and Havran's 20/15) and 2:
-    /// from 1.5 up the SAH splits every cell down to the depth limit and traces slower, while
-    /// 0.75 was the fastest or within noise and builds faster. Our node step is a dependent
-    /// load, so a test costing less than a step is plausible. `λ = 0.8` (Wald and Havran's)
-    /// against no bonus; `leaf_size = 0`, as 1 and 2 changed nothing (the cost decides).
-    /// Measured: see docs/experiments.md, k-d tree.
+    /// `kd-sah`. `K_I / K_T = 0.25`: a leaf tests four triangles in one Tri4 pass that costs
+    /// about one node step, so a triangle costs about a quarter of a step. Measured in
+    /// interleaved rounds against 0.75 (the best value when leaves were tested one triangle at a
+    /// time), 0.5, 0.15 and 0.1 on the bunny, Sponza, conference, teapot and generated scenes of
+    /// other kinds and sizes (hair, city, terrain, soup, a 200k sphere): against 0.75, random
+    /// rays 5–45 % faster on every scene, primary rays level or faster but on Sponza (−9 %, and
+    /// −10 % as packets),
+    /// builds 1.3–1.9× faster with a quarter to a half of the nodes; lower values build faster
+    /// still but lose packets on Sponza and the city. `λ = 0.8` (Wald and Havran's) against no
+    /// bonus; `leaf_size = 0`, as 1 and 2 changed nothing (the cost decides). See
+    /// docs/experiments.md, k-d tree.
     pub fn sah() -> KdParams {
         KdParams {
             builder: Builder::Sah,
             traversal_cost: 1.0,
-            intersection_cost: 0.75,
+            intersection_cost: 0.25,
             empty_bonus: 0.8,
             max_depth: None,
             leaf_size: 0,

@@ -46,7 +46,7 @@ use crate::KdTree;
 use crate::node::MAX_DEPTH;
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::tri4::LANES;
-use raybench_geom::{Ray, TriHit, max_keep, min_keep};
+use raybench_geom::{Ray, TriHit, max_keep, min_keep, prefetch};
 
 /// Mailbox size, a power of two. 8 slots are 32 bytes, two stores per ray; 16 compile their
 /// initialisation to a `memset` call. The mailbox saves few tests, because `kd-sah` leaves are
@@ -98,6 +98,7 @@ impl KdTree {
                 let a = node.axis();
                 let t_split = (node.split() - o[a]) * inv[a];
                 let (below, above) = (at + 1, node.above());
+                prefetch(self.nodes.as_ptr().wrapping_add(above as usize));
                 let near = if negative[a] { above } else { below };
                 let far = below ^ above ^ near;
                 if t_split > t1 {
