@@ -234,9 +234,18 @@ impl Accel for KdTree {
                 "costs must be finite and non-negative and intersection_cost > 0 (got {params:?})"
             )));
         }
-        let mut tree = KdTree::from_flat(&mesh, params, Selection::Hittable)?;
-        if mesh.triangles().any(|t| Selection::ZeroArea.holds(&t)) {
-            let side = KdTree::from_flat(&mesh, params, Selection::ZeroArea)?;
+        // The side tree of zero-area triangles is built beside the main one.
+        let has_zero_area = mesh.triangles().any(|t| Selection::ZeroArea.holds(&t));
+        let (tree, side) = rayon::join(
+            || KdTree::from_flat(&mesh, params, Selection::Hittable),
+            || {
+                has_zero_area
+                    .then(|| KdTree::from_flat(&mesh, params, Selection::ZeroArea))
+                    .transpose()
+            },
+        );
+        let mut tree = tree?;
+        if let Some(side) = side? {
             let extra = &mut tree.stats.extra;
             extra.insert("zero_area_tree_nodes".into(), side.stats.nodes as f64);
             extra.insert("zero_area_tree_refs".into(), side.stats.refs as f64);

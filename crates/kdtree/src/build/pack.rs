@@ -14,6 +14,7 @@
 use crate::node::Node;
 use raybench_geom::tri4::LANES;
 use raybench_geom::{MollerTriangle, Tri4, Triangle};
+use rayon::prelude::*;
 
 /// A padding reference.
 pub const PAD: u32 = u32::MAX;
@@ -36,7 +37,7 @@ pub(crate) fn pack(mut nodes: Vec<Node>, refs: &[u32], tris: &[Triangle]) -> Pac
         padded.resize(padded.len().next_multiple_of(LANES), PAD);
     }
     let tri4s = padded
-        .chunks_exact(LANES)
+        .par_chunks_exact(LANES)
         .map(|four| {
             let mut t = Tri4::default();
             for (lane, &id) in four.iter().enumerate().filter(|(_, id)| **id != PAD) {

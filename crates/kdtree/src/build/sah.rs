@@ -22,7 +22,7 @@
 //! assumptions (uniform rays, no early termination) reward cutting off empty space, which
 //! `λ` makes explicit; it is a knob, not a law.
 
-use super::{Ctx, Out, Share, Stop};
+use super::{Ctx, LARGE_LEAF, Out, Share, Stop};
 use crate::KdParams;
 use crate::clip::{halves, straddler_bounds};
 use raybench_geom::Aabb;
@@ -100,8 +100,15 @@ fn node(
     } else if depth >= ctx.max_depth {
         Err(Stop::Depth)
     } else {
+        // Beyond LARGE_LEAF triangles a split that separates anything is made even when the
+        // cost model prefers the leaf (long crossing strands, where every plane duplicates
+        // many references): such a leaf costs every ray through it a dozen Tri4 passes, and the
+        // depth limit and the memory share still bound the splitting.
         best_split(&ev, n, &cell, p)
-            .filter(|s| s.cost < p.intersection_cost as f64 * n as f64)
+            .filter(|s| {
+                s.cost < p.intersection_cost as f64 * n as f64
+                    || (n > LARGE_LEAF && (s.n_below < n || s.n_above < n))
+            })
             .ok_or(Stop::Cost)
             .and_then(|s| {
                 if share.fits(s.n_below, s.n_above) {
