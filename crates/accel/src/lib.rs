@@ -12,6 +12,8 @@
 mod brute;
 pub mod classify;
 pub mod classify_points;
+#[cfg(target_arch = "x86_64")]
+pub mod coherent;
 mod counters;
 mod mailbox;
 mod nearest;

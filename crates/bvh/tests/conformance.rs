@@ -408,43 +408,12 @@ fn packet_walk_conforms() {
                 let bvh = BvhWide::<W>::build(case.mesh.clone(), &params).expect("builds");
                 let rays = raybench_testkit::valid_rays(&case);
                 // Ties are common here (rays along shared edges are what some cases are for).
-                packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
+                raybench_testkit::packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
             }
         }
     }
     at::<8>();
     at::<4>();
-}
-
-/// Traces `rays` as one coherent batch and checks every answer against the single-ray walk:
-/// identical, or a different triangle at the same distance. Returns (identical hits, ties).
-fn packets_against_single_rays<const W: usize>(
-    bvh: &BvhWide<W>,
-    mesh: &raybench_geom::TriangleMesh,
-    rays: &[raybench_geom::Ray],
-    what: &str,
-) -> (usize, usize) {
-    use raybench_accel::Accel;
-    use raybench_accel::classify::{Tolerance, Verdict, classify};
-    let prepared = bvh.prepare_coherent_rays(rays).expect("rays are valid");
-    let mut packets = vec![None; rays.len()];
-    bvh.intersect_prepared(rays, &prepared, 0, &mut packets);
-    let (mut hits, mut ties) = (0, 0);
-    for (ray, packet) in rays.iter().zip(&packets) {
-        let single = bvh.intersect(ray);
-        if *packet == single {
-            hits += single.is_some() as usize;
-            continue;
-        }
-        let tie = packet.zip(single).is_some_and(|(a, b)| a.prim != b.prim)
-            && classify(mesh, ray, *packet, single, &Tolerance::default()) == Verdict::Tie;
-        assert!(
-            tie,
-            "{what}: {ray:?}: packets {packet:?}, single ray {single:?}"
-        );
-        ties += 1;
-    }
-    (hits, ties)
 }
 
 /// Camera rays in scanline order, as the `primary` workload makes them, on scenes of every kind and
@@ -491,7 +460,7 @@ fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
             let (rays, _, _) = primary_rays(&view, &b, 20_000);
             let prepared = bvh.prepare_coherent_rays(&rays).expect("rays are valid");
             assert!(matches!(prepared, PreparedRays::Foreign(_)));
-            let (h, t) = packets_against_single_rays(&bvh, &mesh, &rays, spec);
+            let (h, t) = raybench_testkit::packets_against_single_rays(&bvh, &mesh, &rays, spec);
             hits += h;
             ties += t;
             mixed_packets += rays

@@ -267,8 +267,7 @@ impl Accel for KdTree {
     fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
         #[cfg(target_arch = "x86_64")]
         if self.coherent.is_some() {
-            let packets = raybench_geom::packet::RayPackets::new(rays);
-            return Ok(PreparedRays::Foreign(Box::new(packets)));
+            return Ok(raybench_accel::coherent::prepare_packets(rays));
         }
         self.prepare_rays(rays)
     }
@@ -281,9 +280,9 @@ impl Accel for KdTree {
         out: &mut [Option<Hit>],
     ) {
         #[cfg(target_arch = "x86_64")]
-        if let (Some(k), PreparedRays::Foreign(any)) = (self.coherent, prepared)
-            && let Some(packets) = any.downcast_ref::<raybench_geom::packet::RayPackets>()
-            && let Some(blocks) = packets.range(first, out.len())
+        if let Some(k) = self.coherent
+            && let Some(blocks) =
+                raybench_accel::coherent::packet_blocks(prepared, first, out.len())
         {
             return packets::intersect_coherent(k, self, &rays[first..], blocks, out);
         }

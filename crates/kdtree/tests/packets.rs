@@ -4,41 +4,11 @@
 //! the same arithmetic, so answers are identical but for exact ties between two triangles
 //! (a leaf's triangles are met in lane order by the packet, nearest-lane-first by a single ray).
 
-use raybench_accel::classify::{Tolerance, Verdict, classify};
 use raybench_accel::{Accel, PreparedRays};
-use raybench_geom::{Ray, TriangleMesh, Vec3};
+use raybench_geom::Vec3;
 use raybench_kdtree::{KdParams, KdTree};
-use raybench_testkit::conformance;
+use raybench_testkit::{conformance, packets_against_single_rays};
 use raybench_testkit::scenes::{Camera, View, primary_rays};
-
-/// Traces `rays` as one coherent batch and checks every answer against the single-ray walk.
-/// Returns (identical hits, ties).
-fn packets_against_single_rays(
-    kd: &KdTree,
-    mesh: &TriangleMesh,
-    rays: &[Ray],
-    what: &str,
-) -> (usize, usize) {
-    let prepared = kd.prepare_coherent_rays(rays).expect("rays are valid");
-    let mut packets = vec![None; rays.len()];
-    kd.intersect_prepared(rays, &prepared, 0, &mut packets);
-    let (mut hits, mut ties) = (0, 0);
-    for (ray, packet) in rays.iter().zip(&packets) {
-        let single = kd.intersect(ray);
-        if *packet == single {
-            hits += single.is_some() as usize;
-            continue;
-        }
-        let tie = packet.zip(single).is_some_and(|(a, b)| a.prim != b.prim)
-            && classify(mesh, ray, *packet, single, &Tolerance::default()) == Verdict::Tie;
-        assert!(
-            tie,
-            "{what}: {ray:?}: packets {packet:?}, single ray {single:?}"
-        );
-        ties += 1;
-    }
-    (hits, ties)
-}
 
 #[test]
 fn packet_walk_conforms() {

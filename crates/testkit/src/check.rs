@@ -188,3 +188,34 @@ pub fn expect_too_large<A: Accel>(mesh: &Arc<TriangleMesh>, params: &A::Params) 
         ),
     }
 }
+
+/// Traces `rays` as one coherent batch (`prepare_coherent_rays`, then `intersect_prepared`) and
+/// checks every answer against the single-ray path: identical, or a different triangle at the
+/// same distance (a packet walk may meet a leaf's triangles in another order). For packet
+/// walks held to their single-ray walk's arithmetic. Returns (identical hits, ties).
+pub fn packets_against_single_rays<A: Accel>(
+    accel: &A,
+    mesh: &TriangleMesh,
+    rays: &[Ray],
+    what: &str,
+) -> (usize, usize) {
+    let prepared = accel.prepare_coherent_rays(rays).expect("rays are valid");
+    let mut packets = vec![None; rays.len()];
+    accel.intersect_prepared(rays, &prepared, 0, &mut packets);
+    let (mut hits, mut ties) = (0, 0);
+    for (ray, packet) in rays.iter().zip(&packets) {
+        let single = accel.intersect(ray);
+        if *packet == single {
+            hits += single.is_some() as usize;
+            continue;
+        }
+        let tie = packet.zip(single).is_some_and(|(a, b)| a.prim != b.prim)
+            && classify(mesh, ray, *packet, single, &Tolerance::default()) == Verdict::Tie;
+        assert!(
+            tie,
+            "{what}: {ray:?}: packets {packet:?}, single ray {single:?}"
+        );
+        ties += 1;
+    }
+    (hits, ties)
+}

@@ -23,7 +23,7 @@ pub mod points;
 mod rays;
 
 pub use cases::{Case, edge_cases, seeded_cases};
-pub use check::{check_case, expect_too_large, valid_rays};
+pub use check::{check_case, expect_too_large, packets_against_single_rays, valid_rays};
 pub use lattice::{check_lattice, lattice_rays, lattice_scene};
 /// The scene generators, for structure crates' tests (which depend on testkit, not on scenes).
 pub use raybench_scenes as scenes;

@@ -213,8 +213,7 @@ impl<const W: usize> Accel for BvhWide<W> {
     fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
         #[cfg(target_arch = "x86_64")]
         if self.coherent.is_some() {
-            let packets = raybench_geom::packet::RayPackets::new(rays);
-            return Ok(PreparedRays::Foreign(Box::new(packets)));
+            return Ok(raybench_accel::coherent::prepare_packets(rays));
         }
         Ok(PreparedRays::Native)
     }
@@ -227,9 +226,9 @@ impl<const W: usize> Accel for BvhWide<W> {
         out: &mut [Option<Hit>],
     ) {
         #[cfg(target_arch = "x86_64")]
-        if let (Some(k), PreparedRays::Foreign(any)) = (self.coherent, prepared)
-            && let Some(packets) = any.downcast_ref::<raybench_geom::packet::RayPackets>()
-            && let Some(packets) = packets.range(first, out.len())
+        if let Some(k) = self.coherent
+            && let Some(packets) =
+                raybench_accel::coherent::packet_blocks(prepared, first, out.len())
         {
             return packets::intersect_coherent(k, self, packets, out);
         }
