@@ -14,6 +14,15 @@ fn both_variants() -> [KdParams; 2] {
     [KdParams::sah(), KdParams::median()]
 }
 
+/// Builds on a pool of `threads` rayon workers.
+fn build_on(threads: usize, mesh: &Arc<TriangleMesh>, p: &KdParams) -> KdTree {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| KdTree::build(mesh.clone(), p).unwrap())
+}
+
 fn check(case: &Case) {
     for p in both_variants() {
         let counts = check_case::<KdTree>(case, &p, &|kd, m| kd.validate(m))
@@ -139,14 +148,7 @@ fn the_memory_limit_caps_duplication_deterministically() {
         memory_limit_bytes: 2000 * 116 + 4000 * 112,
         ..KdParams::sah()
     };
-    let build = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| KdTree::build(mesh.clone(), &p).unwrap())
-    };
-    let (one, four) = (build(1), build(4));
+    let (one, four) = (build_on(1, &mesh, &p), build_on(4, &mesh, &p));
     assert_eq!(one.validate(&mesh), Ok(()));
     let s = one.build_stats();
     assert!(s.refs <= 4000 && s.refs > 2000, "{s:?}");
@@ -191,14 +193,7 @@ fn parallel_and_sequential_builds_make_the_same_tree() {
             parallel_threshold: 256,
             ..p
         };
-        let build = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-                .install(|| KdTree::build(mesh.clone(), &p).unwrap())
-        };
-        let (one, four) = (build(1), build(4));
+        let (one, four) = (build_on(1, &mesh, &p), build_on(4, &mesh, &p));
         assert_eq!(four.validate(&mesh), Ok(()));
         assert_eq!(one.nodes(), four.nodes(), "{}", p.name());
         assert_eq!(one.refs(), four.refs());

@@ -7,8 +7,8 @@
 use raybench_accel::{Accel, PreparedRays};
 use raybench_geom::Vec3;
 use raybench_kdtree::{KdParams, KdTree};
-use raybench_testkit::{conformance, packets_against_single_rays};
 use raybench_testkit::scenes::{Camera, View, primary_rays};
+use raybench_testkit::{conformance, packets_against_single_rays};
 
 #[test]
 fn packet_walk_conforms() {
