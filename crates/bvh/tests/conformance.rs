@@ -426,7 +426,6 @@ fn packet_walk_conforms() {
 #[test]
 fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
     use raybench_accel::{Accel, PreparedRays};
-    use raybench_testkit::scenes::{Camera, View, primary_rays};
     let params = WideParams {
         coherent_packets: true,
         ..WideParams::for_width(8)
@@ -446,18 +445,7 @@ fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
             eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to compare");
             return;
         }
-        let b = mesh.bounds();
-        let inside = View {
-            camera: Camera {
-                eye: b.center(),
-                target: b.center() + raybench_geom::Vec3::new(0.0, 0.0, -1.0),
-                up: raybench_geom::Vec3::Y,
-                fov_y_deg: 90.0,
-            },
-            light: scene.view.light,
-        };
-        for view in [scene.view, inside] {
-            let (rays, _, _) = primary_rays(&view, &b, 20_000);
+        for rays in raybench_testkit::camera_ray_sets(&scene, 20_000) {
             let prepared = bvh.prepare_coherent_rays(&rays).expect("rays are valid");
             assert!(matches!(prepared, PreparedRays::Foreign(_)));
             let (h, t) = raybench_testkit::packets_against_single_rays(&bvh, &mesh, &rays, spec);

@@ -5,9 +5,7 @@
 //! (a leaf's triangles are met in lane order by the packet, nearest-lane-first by a single ray).
 
 use raybench_accel::{Accel, PreparedRays};
-use raybench_geom::Vec3;
 use raybench_kdtree::{KdParams, KdTree};
-use raybench_testkit::scenes::{Camera, View, primary_rays};
 use raybench_testkit::{conformance, packets_against_single_rays};
 
 #[test]
@@ -46,18 +44,7 @@ fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
             eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to compare");
             return;
         }
-        let b = mesh.bounds();
-        let inside = View {
-            camera: Camera {
-                eye: b.center(),
-                target: b.center() + Vec3::new(0.0, 0.0, -1.0),
-                up: Vec3::Y,
-                fov_y_deg: 90.0,
-            },
-            light: scene.view.light,
-        };
-        for view in [scene.view, inside] {
-            let (rays, _, _) = primary_rays(&view, &b, 20_000);
+        for rays in raybench_testkit::camera_ray_sets(&scene, 20_000) {
             let prepared = kd.prepare_coherent_rays(&rays).expect("rays are valid");
             assert!(matches!(prepared, PreparedRays::Foreign(_)));
             let (h, t) = packets_against_single_rays(&kd, &mesh, &rays, spec);

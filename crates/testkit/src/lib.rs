@@ -27,7 +27,7 @@ pub use check::{check_case, expect_too_large, packets_against_single_rays, valid
 pub use lattice::{check_lattice, lattice_rays, lattice_scene};
 /// The scene generators, for structure crates' tests (which depend on testkit, not on scenes).
 pub use raybench_scenes as scenes;
-pub use rays::{centroid_rays, random_rays_in, refused_rays, seeded_rng};
+pub use rays::{camera_ray_sets, centroid_rays, random_rays_in, refused_rays, seeded_rng};
 
 use raybench_accel::Accel;
 use raybench_accel::classify::VerdictCounts;

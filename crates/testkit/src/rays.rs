@@ -75,3 +75,22 @@ pub fn refused_rays() -> [Ray; 4] {
         Ray::new(Vec3::splat(1.0), Vec3::X, f32::NAN, f32::NAN),
     ]
 }
+
+/// Camera rays in scanline order (as the `primary` workload makes them), about `n` per view,
+/// from two views of `scene`: its own, and an eye at the centre of its bounds looking along -z,
+/// so rays start inside the scene and a packet of neighbouring rays spans several direction
+/// octants. For packet walks, which treat octants and rays starting inside specially.
+pub fn camera_ray_sets(scene: &raybench_scenes::Scene, n: usize) -> [Vec<Ray>; 2] {
+    use raybench_scenes::{Camera, View, primary_rays};
+    let b = scene.mesh.bounds();
+    let inside = View {
+        camera: Camera {
+            eye: b.center(),
+            target: b.center() + Vec3::new(0.0, 0.0, -1.0),
+            up: Vec3::Y,
+            fov_y_deg: 90.0,
+        },
+        light: scene.view.light,
+    };
+    [scene.view, inside].map(|view| primary_rays(&view, &b, n).0)
+}
