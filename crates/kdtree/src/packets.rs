@@ -45,7 +45,7 @@ type PacketStack = [Entry; MAX_DEPTH + 1];
 /// Traces a coherent batch (closest hit), one packet per block: `rays` are the batch's rays
 /// from the first block's first one, `out` gets the first `out.len()` of them.
 pub(crate) fn intersect_coherent(
-    k: Avx512Packets,
+    _k: Avx512Packets,
     kd: &KdTree,
     rays: &[Ray],
     blocks: &[RayBlock],
@@ -58,7 +58,6 @@ pub(crate) fn intersect_coherent(
         lanes: 0,
     };
     let mut stack: Box<PacketStack> = Box::new([empty; MAX_DEPTH + 1]);
-    let _ = k;
     // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
     unsafe { intersect_packets(kd, rays, blocks, out, &mut stack) }
 }
