@@ -50,7 +50,7 @@ fn main() {
     build_ms.sort_by(f64::total_cmp);
     let s = kd.build_stats();
     println!(
-        "{} n={} build {:.1} ms nodes {} leaves {} empty {} refs/tri {:.2} depth {} mean leaf depth {:.1} full leaf size {:.2} max leaf {} (sharing a point: {}) depth-capped {} sah {:.1}",
+        "{} n={} build {:.1} ms nodes {} leaves {} empty {} refs/tri {:.2} depth {} mean leaf depth {:.1} full leaf size {:.2} max leaf {} over 64 {} (sharing a point: {}) depth-capped {} sah {:.1}",
         args[0],
         mesh.len(),
         build_ms[build_ms.len() / 2],
@@ -62,6 +62,7 @@ fn main() {
         s.extra["mean_leaf_depth"],
         s.extra["mean_full_leaf_size"],
         s.extra["max_leaf_size"],
+        s.extra["leaves_over_64"],
         s.extra["leaves_over_64_sharing_a_point"],
         s.extra["depth_capped_leaves"],
         s.sah_cost.unwrap_or(0.0)

@@ -58,8 +58,9 @@ pub struct KdParams {
     /// Factor on the cost of a split that leaves one side empty (Wald and Havran's `λ`): below
     /// 1 it rewards cutting off empty space. 1 disables it.
     pub empty_bonus: f32,
-    /// Deepest leaf; `None` means Havran's `round(8 + 1.3 log2 N)`. Never more than
-    /// [`MAX_DEPTH`].
+    /// Deepest leaf; `None` means Havran's `round(8 + 1.3 log2 N)` for cost-driven splits,
+    /// past which cells of more than 64 triangles are still cut while a plane separates them
+    /// (down to [`MAX_DEPTH`]). A value set here is a hard limit. Never more than [`MAX_DEPTH`].
     pub max_depth: Option<u32>,
     /// A node with at most this many triangles is a leaf without trying any split. The SAH
     /// builder also stops whenever no split is cheaper than intersecting every triangle.
@@ -168,7 +169,8 @@ pub struct KdTree {
     prim_ids: Vec<u32>,
     /// The root cell: the bounds of every referenced triangle.
     bounds: Aabb,
-    /// The depth limit the build used (the resolved `max_depth`).
+    /// The deepest leaf may lie this deep: the resolved `max_depth`, or deeper where cells of
+    /// more than `build::LARGE_LEAF` triangles were cut past it (sizes the traversal stacks).
     depth_limit: u32,
     stats: BuildStats,
     /// Which triangles this tree holds: the hittable ones, or (the side tree) the zero-area ones.
@@ -329,7 +331,7 @@ impl KdTree {
             tri4s: flat.tri4s,
             prim_ids: flat.prim_ids,
             bounds: flat.bounds,
-            depth_limit: flat.depth_limit,
+            depth_limit: flat.deepest,
             stats: flat.stats,
             selection,
             mesh: mesh.clone(),

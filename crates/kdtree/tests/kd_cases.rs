@@ -124,7 +124,7 @@ fn a_huge_triangle_over_small_ones_stays_bounded() {
             p.name()
         );
         assert_eq!(s.extra["memory_capped_leaves"], 0.0, "{}", p.name());
-        assert!(s.max_depth <= s.extra["depth_limit"] as u32);
+        assert!(s.max_depth <= raybench_kdtree::MAX_DEPTH as u32);
     }
     let rays = random_rays_in(&mesh.bounds().enlarged(0.1), 3000, SEED);
     check(&Case {
@@ -183,6 +183,48 @@ fn the_cost_model_alone_ends_splitting() {
         s.extra["leaves_over_64"], s.extra["leaves_over_64_sharing_a_point"],
         "{s:?}"
     );
+}
+
+/// The depth limit ends cost-driven splitting only: a cell of more than 64 triangles that
+/// planes can still separate is cut past it. Thirty clusters of 80 parallel sheets, each
+/// cluster half the size and distance of the one before, make a chain of cells deeper than
+/// Havran's limit for 2,400 triangles (22), with a crowded cell at its end.
+#[test]
+fn crowded_cells_are_cut_past_the_depth_limit() {
+    let mut tris = Vec::new();
+    for k in 0..30 {
+        let s = 0.5f32.powi(k);
+        for i in 0..80 {
+            let x = s * (1.0 + 0.5 * i as f32 / 80.0);
+            tris.push(Triangle::new(
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x, s * 0.4, 0.0),
+                Vec3::new(x, 0.0, s * 0.4),
+            ));
+        }
+    }
+    let mesh = Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0);
+    let kd = KdTree::build(mesh.clone(), &KdParams::sah()).unwrap();
+    assert_eq!(kd.validate(&mesh), Ok(()));
+    let s = kd.build_stats();
+    assert!(s.max_depth > s.extra["depth_limit"] as u32, "{s:?}");
+    assert_eq!(s.extra["leaves_over_64"], 0.0, "{s:?}");
+    // A hard limit given by the user is kept, large leaves and all.
+    let capped = KdParams {
+        max_depth: Some(s.extra["depth_limit"] as u32),
+        ..KdParams::sah()
+    };
+    let kd = KdTree::build(mesh.clone(), &capped).unwrap();
+    let c = kd.build_stats();
+    assert!(c.max_depth <= c.extra["depth_limit"] as u32, "{c:?}");
+    assert!(c.extra["leaves_over_64"] > 0.0, "{c:?}");
+    let rays = random_rays_in(&mesh.bounds().enlarged(0.1), 3000, SEED);
+    check(&Case {
+        name: "nested-clusters".into(),
+        seed: SEED,
+        mesh,
+        rays,
+    });
 }
 
 #[test]

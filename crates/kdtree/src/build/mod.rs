@@ -9,7 +9,8 @@
 //! one rule of [`crate::clip::side`]. Termination and degenerate input are handled the same
 //! way in both: a split plane always lies strictly inside its cell (so no child is ever flat
 //! on the split axis, and a flat root cell is never split on its flat axis), the depth is
-//! capped ([`KdParams::max_depth`], at most [`MAX_DEPTH`]), and each subtree holds at most its
+//! capped ([`KdParams::max_depth`], at most [`MAX_DEPTH`]; past the default limit only cells of
+//! more than [`LARGE_LEAF`] triangles are cut, while a plane separates them), and each subtree holds at most its
 //! [`Share`] of the references the memory limit allows, so neither recursion nor memory can
 //! grow without bound, whatever the input (huge triangles spanning the scene, thousands of
 //! triangles in one plane or at one point). Within those guards the SAH builder stops where
@@ -46,6 +47,10 @@ pub(crate) struct Ctx<'a> {
     pub tris: &'a [Triangle],
     pub params: &'a KdParams,
     pub max_depth: u32,
+    /// How deep a node of more than [`LARGE_LEAF`] triangles may still be split: the depth
+    /// limit only ends cost-driven splitting, so a crowded cell at the limit keeps being cut
+    /// (down to the traversal stack's [`MAX_DEPTH`]) while any plane separates its triangles.
+    pub large_max_depth: u32,
     pub root_area: f64,
     /// Nodes above this depth may build their subtrees on two rayon tasks.
     pub fork_depth: u32,
@@ -89,22 +94,46 @@ impl Share {
     }
 }
 
-/// A leaf with more triangles than this is a termination failure unless the triangles' bounds
-/// share a point (a pile of triangles through one point, which planes cannot cut apart near
-/// it); both kinds are counted.
+/// A leaf with more triangles than this is a termination failure unless more than this many
+/// of its triangles pass through one point (a pile, which planes cannot cut apart near that
+/// point); both kinds are counted.
 pub const LARGE_LEAF: usize = 64;
 
-/// Whether the bounds of the triangles `ids` have a point in common (what triangles through one
-/// point have; bounds are the cheap, conservative test).
-fn bounds_share_a_point(tris: &[Triangle], ids: &[u32]) -> bool {
+/// Whether more than [`LARGE_LEAF`] of the triangles `ids` pass near one point: the bounds of
+/// all of them share a point, or one of their vertices lies in the bounds of more than
+/// [`LARGE_LEAF`] of them (a fan around a shared vertex, with a few strays that keep the bounds
+/// of all from meeting). At most [`PILE_PROBES`] triangles' vertices are probed, spread evenly
+/// over `ids`, so the test costs O(n) per call; bounds are the cheap, conservative test.
+pub(crate) fn is_pile(tris: &[Triangle], ids: &[u32]) -> bool {
+    if ids.len() <= LARGE_LEAF {
+        return false;
+    }
     let (lo, hi) = ids
         .iter()
         .fold((Vec3::NEG_INFINITY, Vec3::INFINITY), |(lo, hi), &i| {
             let b = tris[i as usize].bounds();
             (lo.max(b.min), hi.min(b.max))
         });
-    lo.cmple(hi).all()
+    if lo.cmple(hi).all() {
+        return true;
+    }
+    let step = ids.len().div_ceil(PILE_PROBES);
+    ids.iter()
+        .step_by(step)
+        .flat_map(|&i| {
+            let t = &tris[i as usize];
+            [t.v0, t.v1, t.v2]
+        })
+        .any(|p| {
+            ids.iter()
+                .filter(|&&j| tris[j as usize].bounds().contains(p))
+                .count()
+                > LARGE_LEAF
+        })
 }
+
+/// How many triangles' vertices [`is_pile`] probes.
+const PILE_PROBES: usize = 64;
 
 /// Why a node became a leaf, for the statistics.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -183,7 +212,7 @@ impl Out {
         s.memory_capped += (stop == Stop::Memory) as u64;
         if count as usize > LARGE_LEAF {
             s.large += 1;
-            s.large_piles += bounds_share_a_point(ctx.tris, &ids) as u64;
+            s.large_piles += is_pile(ctx.tris, &ids) as u64;
         }
         if ctx.root_area > 0.0 {
             s.sah += cell.surface_area() / ctx.root_area * count as f64 * SAH_INTERSECTION_COST;
@@ -228,7 +257,8 @@ pub(crate) struct Flat {
     pub tri4s: Vec<Tri4>,
     pub prim_ids: Vec<u32>,
     pub bounds: Aabb,
-    pub depth_limit: u32,
+    /// The deepest a leaf lies: the depth limit, or deeper where crowded cells were split on.
+    pub deepest: u32,
     pub stats: BuildStats,
 }
 
@@ -278,6 +308,11 @@ pub(crate) fn build(
         .max_depth
         .unwrap_or_else(|| default_max_depth(n))
         .min(MAX_DEPTH as u32);
+    // A limit the user set is a hard one; Havran's default only ends cost-driven splitting.
+    let large_max_depth = match params.max_depth {
+        Some(_) => depth_limit,
+        None => MAX_DEPTH as u32,
+    };
     // The packed node holds 30-bit reference offsets; leave room below that.
     let share = Share(affordable_refs.min(u32::MAX as u64 / 2));
     let threads = rayon::current_num_threads();
@@ -285,6 +320,7 @@ pub(crate) fn build(
         tris: &tris,
         params,
         max_depth: depth_limit,
+        large_max_depth,
         root_area: bounds.surface_area(),
         // A few tasks per worker (2^fork_depth ≥ 4 × threads), none with one thread, and
         // only where the reference share is divided in proportion.
@@ -309,6 +345,8 @@ pub(crate) fn build(
         )));
     }
     let stats = stats(&out.shape, n, excluded, depth_limit, bounds.surface_area());
+    // The traversal stack must hold the deepest path, which may pass the cost-driven limit.
+    let deepest = depth_limit.max(out.shape.max_depth);
     let packed = pack::pack(out.nodes, &out.refs, &tris);
     Ok(Flat {
         nodes: packed.nodes,
@@ -316,7 +354,7 @@ pub(crate) fn build(
         tri4s: packed.tri4s,
         prim_ids: packed.prim_ids,
         bounds,
-        depth_limit,
+        deepest,
         stats,
     })
 }
@@ -382,4 +420,45 @@ fn references_within_memory(n: usize, params: &KdParams) -> Result<u64, BuildErr
         });
     }
     Ok(affordable)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fan of triangles around one vertex is a pile even with strays that keep the bounds of
+    /// all from meeting; a row of disjoint triangles is not.
+    #[test]
+    fn a_fan_with_strays_is_a_pile_and_a_row_is_not() {
+        let fan: Vec<Triangle> = (0..80)
+            .map(|i| {
+                let a = i as f32 * 0.07;
+                let (s, c) = a.sin_cos();
+                Triangle::new(Vec3::ZERO, Vec3::new(c, s, 0.1), Vec3::new(c, s, -0.1))
+            })
+            .chain((0..3).map(|i| {
+                let x = 5.0 + i as f32;
+                Triangle::new(
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x, 1.0, 0.0),
+                    Vec3::new(x, 0.0, 1.0),
+                )
+            }))
+            .collect();
+        let ids: Vec<u32> = (0..fan.len() as u32).collect();
+        assert!(is_pile(&fan, &ids));
+        assert!(!is_pile(&fan, &ids[..64]), "64 triangles are never a pile");
+        let row: Vec<Triangle> = (0..100)
+            .map(|i| {
+                let x = i as f32;
+                Triangle::new(
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x + 0.5, 1.0, 0.0),
+                    Vec3::new(x, 0.0, 1.0),
+                )
+            })
+            .collect();
+        let ids: Vec<u32> = (0..row.len() as u32).collect();
+        assert!(!is_pile(&row, &ids));
+    }
 }

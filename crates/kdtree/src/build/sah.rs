@@ -68,6 +68,17 @@ impl Scratch {
     }
 }
 
+/// Whether more than [`LARGE_LEAF`] of the node's triangles pass near one point, where no plane
+/// can cut them apart ([`super::is_pile`]).
+fn is_pile(ctx: &Ctx, ev: &Events) -> bool {
+    let ids: Vec<u32> = ev[0]
+        .iter()
+        .filter(|&&e| kind_of(e) != END)
+        .map(|&e| tri_of(e))
+        .collect();
+    super::is_pile(ctx.tris, &ids)
+}
+
 /// A chosen split.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Split {
@@ -95,15 +106,18 @@ fn node(
     out: &mut Out,
 ) {
     let p = ctx.params;
+    let past_limit = depth >= ctx.max_depth;
     let chosen = if n <= p.leaf_size as usize {
         Err(Stop::Cost)
-    } else if depth >= ctx.max_depth {
+    } else if depth >= ctx.large_max_depth || (past_limit && (n <= LARGE_LEAF || is_pile(ctx, &ev)))
+    {
         Err(Stop::Depth)
     } else {
         // Beyond LARGE_LEAF triangles a split that separates anything is made even when the
         // cost model prefers the leaf (long crossing strands, where every plane duplicates
         // many references): such a leaf costs every ray through it a dozen Tri4 passes, and the
-        // depth limit and the memory share still bound the splitting.
+        // stack depth and the memory share still bound the splitting. Past the depth limit only
+        // crowded cells that are not piles are cut, so a pile is not peeled a triangle a level.
         best_split(&ev, n, &cell, p)
             .filter(|s| {
                 s.cost < p.intersection_cost as f64 * n as f64
@@ -484,6 +498,7 @@ mod tests {
                 tris: &tris,
                 params: &p,
                 max_depth: 30,
+                large_max_depth: 30,
                 root_area: 1.0,
                 fork_depth: 0,
             };
