@@ -79,6 +79,13 @@ impl Layout {
         };
         let e = max - min;
         let res = resolution(e.to_array(), n, params.density, params.max_resolution);
+        let margin = min.abs().max(max.abs()).max_element() * MARGIN_REL;
+        Layout::over(min, max, res, margin)
+    }
+
+    /// `res` cells over the box `[min, max]`, each enlarged by `margin` for insertion.
+    pub fn over(min: DVec3, max: DVec3, res: [u32; 3], margin: f64) -> Layout {
+        let e = max - min;
         let planes = std::array::from_fn(|a| {
             let k = res[a] as usize;
             let w = e[a] / k as f64;
@@ -93,7 +100,6 @@ impl Layout {
                 0.0
             }
         });
-        let margin = min.abs().max(max.abs()).max_element() * MARGIN_REL;
         let faces = |a: usize, upper: bool| -> Vec<f32> {
             let p: &Vec<f64> = &planes[a];
             (0..res[a] as usize)
@@ -175,14 +181,30 @@ impl Layout {
     /// axis when it spans two, all 10 non-box axes when it spans three. A triangle with a NaN
     /// coordinate overlaps nothing.
     #[inline]
-    pub fn for_each_cell(&self, tri: &Triangle, mut emit: impl FnMut(usize)) {
+    pub fn for_each_cell(&self, tri: &Triangle, emit: impl FnMut(usize)) {
+        self.insert::<false>(tri, emit)
+    }
+
+    /// [`Layout::for_each_cell`] for a triangle that may reach beyond the layout's box (a
+    /// sub-grid's triangles cross its parent cell's faces): its candidate cells are those of its
+    /// bounding box clipped to the box, and the shortcuts that assume it reaches from the first
+    /// candidate to the last no longer hold, so every candidate but a lone one is tested on all
+    /// ten non-box axes. A lone candidate needs no test: the triangle meets the box (it was
+    /// inserted into the parent cell), within its bounding box, so within that cell.
+    #[inline]
+    pub fn for_each_cell_clipped(&self, tri: &Triangle, emit: impl FnMut(usize)) {
+        self.insert::<true>(tri, emit)
+    }
+
+    #[inline]
+    fn insert<const CLIPPED: bool>(&self, tri: &Triangle, mut emit: impl FnMut(usize)) {
         let b = tri.bounds();
         if !b.min.cmple(b.max).all() {
             return;
         }
         let r: [(u32, u32); 3] = std::array::from_fn(|a| self.range(a, b.min[a], b.max[a]));
         let spread = r.iter().filter(|&&(f, l)| f != l).count();
-        if spread <= 1 {
+        if spread == 0 || (spread == 1 && !CLIPPED) {
             // One row of cells: the triangle lies in the row's (enlarged) cross-section and,
             // being connected, reaches from its bounding box's first cell to its last, so it
             // overlaps every candidate without a test.
@@ -198,7 +220,11 @@ impl Layout {
         let tb = TriBox::new(tri);
         // Spread over two axes: the triangle lies in the slab of the third, so the overlap is
         // the 2D one of the projections along it (its 3 edge axes); over three: the full test.
-        let flat = (0..3).find(|&a| r[a].0 == r[a].1);
+        let flat = if CLIPPED {
+            None
+        } else {
+            (0..3).find(|&a| r[a].0 == r[a].1)
+        };
         for z in r[2].0..=r[2].1 {
             for y in r[1].0..=r[1].1 {
                 for x in r[0].0..=r[0].1 {
@@ -217,7 +243,7 @@ impl Layout {
 }
 
 /// Cells per axis for extents `e`, `n` triangles and density λ (module note).
-fn resolution(e: [f64; 3], n: usize, density: f64, max_res: u32) -> [u32; 3] {
+pub(crate) fn resolution(e: [f64; 3], n: usize, density: f64, max_res: u32) -> [u32; 3] {
     let target = (density * n as f64).max(1.0);
     let mut active = e.map(|x| x > 0.0);
     let mut side = 0.0;

@@ -25,8 +25,10 @@
 #![forbid(unsafe_code)]
 
 pub mod build;
+mod dda;
 mod points;
 mod traverse;
+pub mod two_level;
 mod validate;
 
 use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, Walk};
@@ -34,6 +36,8 @@ use raybench_geom::tri4::LANES;
 use raybench_geom::{Aabb, Ray, Tri4, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
+
+pub use two_level::{Grid2, Grid2Params};
 
 /// The named knobs of a uniform grid, written into every report.
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -23,7 +23,7 @@ use proptest::test_runner::FileFailurePersistence;
 use raybench_accel::classify::VerdictCounts;
 use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, WideParams};
 use raybench_geom::{Aabb, Ray, Triangle, TriangleMesh, Vec3};
-use raybench_grid::{Grid, GridParams};
+use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
 use raybench_kdtree::{KdParams, KdTree};
 use raybench_octree::{Octree, OctreeParams};
 use raybench_testkit::{Case, check_case};
@@ -274,7 +274,7 @@ type Check = fn(&Case) -> Result<VerdictCounts, String>;
 
 /// Every structure with the parameters the registry builds it with
 /// (crates/harness/src/registry.rs), `validate()` after the build.
-const STRUCTURES: [(&str, Check); 12] = [
+const STRUCTURES: [(&str, Check); 14] = [
     ("bvh-median", |c| {
         check_case::<Bvh>(c, &BvhParams::median(), &|a, m| a.validate(m))
     }),
@@ -307,6 +307,21 @@ const STRUCTURES: [(&str, Check); 12] = [
     }),
     ("grid-fine", |c| {
         check_case::<Grid>(c, &GridParams::fine(), &|a, m| a.validate(m))
+    }),
+    ("grid2", |c| {
+        check_case::<Grid2>(c, &Grid2Params::default(), &|a, m| a.validate(m))
+    }),
+    // Grids in nearly every cell, many levels deep, even for a few triangles.
+    ("grid2-deep", |c| {
+        let p = Grid2Params {
+            top_density: 1.0 / 16.0,
+            crowded: 0,
+            max_levels: 6,
+            entry_cost: 0.0,
+            cell_cost: 0.0,
+            ..Grid2Params::default()
+        };
+        check_case::<Grid2>(c, &p, &|a, m| a.validate(m))
     }),
     ("octree", |c| {
         check_case::<Octree>(c, &OctreeParams::default(), &|a, m| a.validate(m))
