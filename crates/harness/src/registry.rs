@@ -5,7 +5,7 @@ use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
 use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
-use raybench_grid::{Grid, GridParams};
+use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
 use raybench_kdtree::{KdParams, KdTree};
 use raybench_octree::{Octree, OctreeParams};
 use std::sync::Arc;
@@ -195,6 +195,12 @@ pub fn registry() -> Vec<StructureEntry> {
             "uniform grid, λ = 8 cells per triangle (too many cells), exact insertion, 3D-DDA",
             None,
             |_| GridParams::fine(),
+        ),
+        register::<Grid2>(
+            "grid2",
+            "hierarchical grid: a top grid of λ = 1/16 whose cells hold grids of λ = 2 over their triangles' extent, crowded cells recursing (Jevans–Wyvill; Kalojanov et al. 2011), exact insertion, 3D-DDA at every level, one mailbox",
+            None,
+            |_| Grid2Params::default(),
         ),
         register::<Octree>(
             "octree",
