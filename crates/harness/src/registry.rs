@@ -198,7 +198,7 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<Grid2>(
             "grid2",
-            "hierarchical grid: a top grid of λ = 1/16 whose cells hold grids of λ = 2 over their triangles' extent, crowded cells recursing (Jevans–Wyvill; Kalojanov et al. 2011), exact insertion, 3D-DDA at every level, one mailbox",
+            "hierarchical grid: the λ = 1 grid, whose cells of more than 8 triangles hold grids of λ = 2 over their triangles' extent where a cost model says a ray gains, 3 levels (Jevans–Wyvill; Kalojanov et al. 2011), exact insertion, 3D-DDA at every level, one mailbox",
             None,
             |_| Grid2Params::default(),
         ),
