@@ -48,7 +48,7 @@ pub struct Layout {
     /// Every cell is enlarged by this on every side for insertion.
     pub margin: f64,
     /// Cells per unit length (for the first guess of a cell index; 0 with one cell).
-    inv_width: [f32; 3],
+    pub inv_width: [f32; 3],
     /// Per axis and cell, the enlarged cell's faces `planes[c] - margin` and
     /// `planes[c + 1] + margin` rounded inwards to f32 (up and down), so that for an f32
     /// coordinate `x`, `lower <= x` and `x <= upper` hold exactly when they hold against the
@@ -131,6 +131,21 @@ impl Layout {
     #[inline(always)]
     pub fn index(&self, [x, y, z]: [u32; 3]) -> usize {
         x as usize + self.res[0] as usize * (y as usize + self.res[1] as usize * z as usize)
+    }
+
+    /// The cell of linear index `i` (the inverse of [`Layout::index`]).
+    pub fn coords(&self, i: usize) -> [u32; 3] {
+        let (nx, ny) = (self.res[0] as usize, self.res[1] as usize);
+        [
+            (i % nx) as u32,
+            (i / nx % ny) as u32,
+            (i / (nx * ny)) as u32,
+        ]
+    }
+
+    /// Axis `a`'s cell planes rounded to f32, as traversal uses them.
+    pub fn f32_planes(&self, a: usize) -> Vec<f32> {
+        self.planes[a].iter().map(|&p| p as f32).collect()
     }
 
     /// Cell `(x, y, z)` enlarged by the margin: the box the overlap test sees.
@@ -369,19 +384,8 @@ pub(crate) fn build(mesh: &Arc<TriangleMesh>, params: &GridParams) -> Result<Gri
         }
     }
     let stats = stats(&layout, &offsets, total, n, params);
-    let (min, max) = if bounds.is_empty() {
-        (DVec3::ZERO, DVec3::ZERO)
-    } else {
-        (bounds.min.as_dvec3(), bounds.max.as_dvec3())
-    };
-    let planes = std::array::from_fn(|a| layout.planes[a].iter().map(|&p| p as f32).collect());
-    let inv_width = std::array::from_fn(|a| {
-        if layout.res[a] > 1 {
-            (layout.res[a] as f64 / (max[a] - min[a])) as f32
-        } else {
-            0.0
-        }
-    });
+    let planes = std::array::from_fn(|a| layout.f32_planes(a));
+    let inv_width = layout.inv_width;
     Ok(Grid {
         name: params.name(),
         params: params.clone(),

@@ -125,15 +125,23 @@ impl Grid {
         }
     }
 
-    /// The cell's references, or `None` for an empty cell (the occupancy bitmap, one bit per
-    /// cell and small enough to stay in cache, spares empty cells the load of their offsets).
+    /// Whether cell `u` holds a reference (the occupancy bitmap, one bit per cell and small
+    /// enough to stay in cache, spares empty cells the load of their offsets).
+    #[inline(always)]
+    pub(crate) fn occupied(&self, u: usize) -> bool {
+        self.occupied[u >> 6] >> (u & 63) & 1 != 0
+    }
+
+    /// Cell `u`'s references.
+    #[inline(always)]
+    pub(crate) fn list(&self, u: usize) -> &[u32] {
+        &self.refs[self.offsets[u] as usize..self.offsets[u + 1] as usize]
+    }
+
+    /// The cell's references, or `None` for an empty cell.
     #[inline(always)]
     pub(crate) fn cell_refs(&self, u: usize) -> Option<&[u32]> {
-        if self.occupied[u >> 6] >> (u & 63) & 1 != 0 {
-            Some(&self.refs[self.offsets[u] as usize..self.offsets[u + 1] as usize])
-        } else {
-            None
-        }
+        self.occupied(u).then(|| self.list(u))
     }
 
     pub(crate) fn triangles(&self) -> &[Tri4] {

@@ -42,7 +42,7 @@ pub(crate) fn validate(grid: &Grid, mesh: &TriangleMesh) -> Result<(), String> {
         ));
     }
     for a in 0..3 {
-        let f32_planes: Vec<f32> = grid.layout.planes[a].iter().map(|&p| p as f32).collect();
+        let f32_planes = grid.layout.f32_planes(a);
         if grid.planes[a] != f32_planes {
             return Err(format!(
                 "axis {a}: traversal planes differ from insertion's"

@@ -23,22 +23,9 @@ fn default_conforms() {
     check(Grid2Params::default());
 }
 
-/// Knobs that give grids to nearly every cell, down many levels (free entries and steps):
-/// what the default, which leaves uncrowded cells their lists, rarely builds on small scenes.
-fn deep() -> Grid2Params {
-    Grid2Params {
-        top_density: 1.0 / 16.0,
-        crowded: 0,
-        max_levels: 6,
-        entry_cost: 0.0,
-        cell_cost: 0.0,
-        ..Grid2Params::default()
-    }
-}
-
 #[test]
 fn extreme_knobs_conform() {
-    check(deep());
+    check(Grid2Params::deep());
     // One top cell holding one grid; a fine top grid whose cells rarely need their own;
     // cell grids capped at two cells per axis; very fine cell grids.
     check(Grid2Params {
@@ -131,7 +118,7 @@ fn rays_along_cell_planes_at_both_levels() {
 #[test]
 fn invalid_rays_miss_in_bounded_time() {
     let mesh = generated("soup:triangles=3000", SEED);
-    let g = Grid2::build(mesh.clone(), &deep()).unwrap();
+    let g = Grid2::build(mesh.clone(), &Grid2Params::deep()).unwrap();
     assert!(g.cell_grids() > 0);
     for r in refused_rays() {
         let mut c = Counters::default();
@@ -181,13 +168,17 @@ fn too_large_is_an_error_not_an_abort() {
         },
     );
     // The top grid fits; the cell grids' references do not.
-    let top = Grid::build(mesh.clone(), &GridParams::with_density(deep().top_density)).unwrap();
+    let top = Grid::build(
+        mesh.clone(),
+        &GridParams::with_density(Grid2Params::deep().top_density),
+    )
+    .unwrap();
     let fits = top.memory().total() + 4 * 1024;
     expect_too_large::<Grid2>(
         &mesh,
         &Grid2Params {
             memory_limit_bytes: fits,
-            ..deep()
+            ..Grid2Params::deep()
         },
     );
     let bad = Grid2Params {

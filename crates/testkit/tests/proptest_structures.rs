@@ -313,15 +313,7 @@ const STRUCTURES: [(&str, Check); 14] = [
     }),
     // Grids in nearly every cell, many levels deep, even for a few triangles.
     ("grid2-deep", |c| {
-        let p = Grid2Params {
-            top_density: 1.0 / 16.0,
-            crowded: 0,
-            max_levels: 6,
-            entry_cost: 0.0,
-            cell_cost: 0.0,
-            ..Grid2Params::default()
-        };
-        check_case::<Grid2>(c, &p, &|a, m| a.validate(m))
+        check_case::<Grid2>(c, &Grid2Params::deep(), &|a, m| a.validate(m))
     }),
     ("octree", |c| {
         check_case::<Octree>(c, &OctreeParams::default(), &|a, m| a.validate(m))

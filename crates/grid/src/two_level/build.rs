@@ -20,8 +20,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// their bounds occupy within the cell `(plo, phi)` (enlarged), itself enlarged by the
 /// insertion margin `m` and clipped to the cell (so the box holds every point of every
 /// triangle the cell references, and the DDA's rounding is covered as at the top level). Build
-/// and `validate()` both call it.
-pub(super) fn cell_layout(
+/// and `validate()` both call it, through [`own_grid`].
+fn cell_layout(
     mesh: &TriangleMesh,
     list: &[u32],
     (plo, phi): (DVec3, DVec3),
@@ -67,24 +67,13 @@ const MARGINS_PER_CELL: f64 = 4.0;
 
 /// Whether a cell of a grid at `level` (the top grid is level 0) holding `k` triangles may get
 /// a grid of its own: when it is crowded, at any level but the last.
-pub(super) fn may_subdivide(level: u32, k: usize, params: &Grid2Params) -> bool {
+fn may_subdivide(level: u32, k: usize, params: &Grid2Params) -> bool {
     level + 1 < params.max_levels && k > params.crowded as usize
-}
-
-/// The box of top cell `u`, enlarged by the insertion margin.
-pub(super) fn top_cell_box(top: &Grid, u: usize) -> (DVec3, DVec3) {
-    let [nx, ny, _] = top.layout.res;
-    let (nx, ny) = (nx as usize, ny as usize);
-    top.layout.cell_box([
-        (u % nx) as u32,
-        (u / nx % ny) as u32,
-        (u / (nx * ny)) as u32,
-    ])
 }
 
 /// The cells a triangle list falls into in `layout`, as (offsets, references): cell `c` holds
 /// `refs[offsets[c]..offsets[c + 1]]`, in the list's (ascending) order.
-pub(super) fn insert(mesh: &TriangleMesh, list: &[u32], layout: &Layout) -> (Vec<u32>, Vec<u32>) {
+fn insert(mesh: &TriangleMesh, list: &[u32], layout: &Layout) -> (Vec<u32>, Vec<u32>) {
     let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(list.len() * 2);
     for &id in list {
         layout.for_each_cell_clipped(&mesh.triangle(id as usize), |c| pairs.push((c as u32, id)));
@@ -106,12 +95,51 @@ pub(super) fn insert(mesh: &TriangleMesh, list: &[u32], layout: &Layout) -> (Vec
     (offsets, refs)
 }
 
-/// A cell grid being built: its layout, its cells' lists (also those of cells with a grid of
-/// their own, which the assembly drops) and its cells' own grids.
+/// A grid and its cells' lists: cell `c` holds `refs[offsets[c]..offsets[c + 1]]`.
+pub(super) struct Inserted {
+    pub layout: Layout,
+    pub offsets: Vec<u32>,
+    pub refs: Vec<u32>,
+}
+
+impl Inserted {
+    pub fn list(&self, c: usize) -> &[u32] {
+        &self.refs[self.offsets[c] as usize..self.offsets[c + 1] as usize]
+    }
+}
+
+/// The grid a cell of a grid at `level` (the top grid is level 0) gets for its triangles
+/// `list`, inserted, or `None` when it keeps its list: the cell must be crowded
+/// ([`may_subdivide`]), its grid more than one cell ([`cell_layout`]; `cell` is the cell's
+/// enlarged box, `m` the insertion margin) and [`worth_it`] (first with one reference per
+/// triangle, before paying for the insertion). Build and `validate()` both decide with it.
+pub(super) fn own_grid(
+    mesh: &TriangleMesh,
+    list: &[u32],
+    cell: (DVec3, DVec3),
+    m: f64,
+    level: u32,
+    params: &Grid2Params,
+) -> Option<Inserted> {
+    if !may_subdivide(level, list.len(), params) {
+        return None;
+    }
+    let layout = cell_layout(mesh, list, cell, m, params)?;
+    if !worth_it(list.len(), list.len(), &layout, params) {
+        return None;
+    }
+    let (offsets, refs) = insert(mesh, list, &layout);
+    worth_it(refs.len(), list.len(), &layout, params).then_some(Inserted {
+        layout,
+        offsets,
+        refs,
+    })
+}
+
+/// A cell grid being built: its cells' lists (also those of cells with a grid of their own,
+/// which the assembly drops) and its cells' own grids.
 struct Filled {
-    layout: Layout,
-    offsets: Vec<u32>,
-    refs: Vec<u32>,
+    grid: Inserted,
     children: Vec<(usize, Filled)>,
 }
 
@@ -130,64 +158,29 @@ struct Ctx<'a> {
 /// crossing at one point, or much larger than the cells, fill every cell and fail this, so
 /// they are not copied again level after level; so do cells of a few triangles, which a list
 /// serves faster than a walk.
-pub(super) fn worth_it(refs: usize, k: usize, layout: &Layout, params: &Grid2Params) -> bool {
+fn worth_it(refs: usize, k: usize, layout: &Layout, params: &Grid2Params) -> bool {
     let steps = layout.res.iter().sum::<u32>() as f64 / 2.0;
     let per_cell = refs as f64 / layout.cells() as f64;
     let walk = params.entry_cost + steps * (params.cell_cost + per_cell);
     walk < k as f64
 }
 
-/// Whether a grid `layout` for `k` triangles could be [`worth_it`] at all, before inserting
-/// them: with the fewest references possible, one per triangle. Cells of a few triangles fail
-/// here without paying for an insertion.
-pub(super) fn could_pay(k: usize, layout: &Layout, params: &Grid2Params) -> bool {
-    worth_it(k, k, layout, params)
-}
-
-/// Builds the grid `layout` over `list`, and recursively its crowded cells' grids; `None`
-/// when the grid is not [`worth_it`].
-fn fill(ctx: &Ctx, list: &[u32], layout: Layout, level: u32) -> Result<Option<Filled>, ()> {
-    let (offsets, refs) = insert(ctx.mesh, list, &layout);
-    if !worth_it(refs.len(), list.len(), &layout, ctx.params) {
-        return Ok(None);
-    }
-    let added = refs.len() as u64;
+/// Counts `grid`'s references against the memory budget, then builds the grids of its
+/// cells (it is a grid at `level`), recursively.
+fn fill(ctx: &Ctx, grid: Inserted, level: u32) -> Result<Filled, ()> {
+    let added = grid.refs.len() as u64;
     if ctx.emitted.fetch_add(added, Ordering::Relaxed) + added > ctx.budget {
         return Err(());
     }
-    let [nx, ny, _] = layout.res;
-    let children = (0..layout.cells())
+    let children = (0..grid.layout.cells())
         .into_par_iter()
         .filter_map(|c| {
-            let cell = &refs[offsets[c] as usize..offsets[c + 1] as usize];
-            if !may_subdivide(level, cell.len(), ctx.params) {
-                return None;
-            }
-            let (nx, ny) = (nx as usize, ny as usize);
-            let coords = [
-                (c % nx) as u32,
-                (c / nx % ny) as u32,
-                (c / (nx * ny)) as u32,
-            ];
-            let child = cell_layout(
-                ctx.mesh,
-                cell,
-                layout.cell_box(coords),
-                ctx.margin,
-                ctx.params,
-            )
-            .filter(|l| could_pay(cell.len(), l, ctx.params))?;
-            fill(ctx, cell, child, level + 1)
-                .map(|f| f.map(|f| (c, f)))
-                .transpose()
+            let cell = grid.layout.cell_box(grid.layout.coords(c));
+            let own = own_grid(ctx.mesh, grid.list(c), cell, ctx.margin, level, ctx.params)?;
+            Some(fill(ctx, own, level + 1).map(|f| (c, f)))
         })
         .collect::<Result<Vec<_>, ()>>()?;
-    Ok(Some(Filled {
-        layout,
-        offsets,
-        refs,
-        children,
-    }))
+    Ok(Filled { grid, children })
 }
 
 /// Bytes per cell-grid reference at the build's peak: the (cell, triangle) pair, the list
@@ -218,15 +211,9 @@ pub(super) fn build(mesh: &Arc<TriangleMesh>, params: &Grid2Params) -> Result<Gr
     let filled: Vec<(usize, Filled)> = (0..top_cells)
         .into_par_iter()
         .filter_map(|u| {
-            let list = top.cell_refs(u)?;
-            if !may_subdivide(0, list.len(), params) {
-                return None;
-            }
-            let layout = cell_layout(mesh, list, top_cell_box(&top, u), ctx.margin, params)
-                .filter(|l| could_pay(list.len(), l, params))?;
-            fill(&ctx, list, layout, 1)
-                .map(|f| f.map(|f| (u, f)))
-                .transpose()
+            let cell = top.layout.cell_box(top.layout.coords(u));
+            let own = own_grid(mesh, top.cell_refs(u)?, cell, ctx.margin, 0, params)?;
+            Some(fill(&ctx, own, 1).map(|f| (u, f)))
         })
         .collect::<Result<_, ()>>()
         .map_err(|()| {
@@ -288,13 +275,13 @@ impl Arrays {
     /// depth first; returns its grid index.
     fn place(&mut self, f: &Filled, level: u32) -> Result<u32, BuildError> {
         self.levels = self.levels.max(level + 1);
-        let l = &f.layout;
+        let l = &f.grid.layout;
         let index = self.grids.len() as u32;
         let first_cell = self.child.len() as u32;
         let mut starts = [0u32; 3];
         for (a, start) in starts.iter_mut().enumerate() {
             *start = self.planes.len() as u32;
-            self.planes.extend(l.planes[a].iter().map(|&p| p as f32));
+            self.planes.extend(l.f32_planes(a));
         }
         let ends = |a: usize, i: usize| l.planes[a][i] as f32;
         let res = l.res;
@@ -304,14 +291,7 @@ impl Arrays {
                 Vec3::from_array(std::array::from_fn(|a| ends(a, res[a] as usize))),
             ),
             res,
-            inv_width: std::array::from_fn(|a| {
-                let e = l.planes[a][res[a] as usize] - l.planes[a][0];
-                if res[a] > 1 {
-                    (res[a] as f64 / e) as f32
-                } else {
-                    0.0
-                }
-            }),
+            inv_width: l.inv_width,
             planes: starts,
             first_cell,
         });
@@ -322,8 +302,7 @@ impl Arrays {
             if children.peek().is_some_and(|(k, _)| *k == c) {
                 children.next();
             } else {
-                let list = &f.refs[f.offsets[c] as usize..f.offsets[c + 1] as usize];
-                self.refs.extend_from_slice(list);
+                self.refs.extend_from_slice(f.grid.list(c));
             }
         }
         if self.child.len() >= u32::MAX as usize {

@@ -75,6 +75,20 @@ impl Grid2Params {
     /// The most levels a build accepts (the walk recurses once per level).
     pub const LEVEL_LIMIT: u32 = 8;
 
+    /// Grids in nearly every cell, six levels deep (a top grid of 1/16 cell per triangle, no
+    /// crowding threshold, free entries and steps): a stress configuration that exercises
+    /// every level on small scenes, not a fast one.
+    pub fn deep() -> Grid2Params {
+        Grid2Params {
+            top_density: 1.0 / 16.0,
+            crowded: 0,
+            max_levels: 6,
+            entry_cost: 0.0,
+            cell_cost: 0.0,
+            ..Grid2Params::default()
+        }
+    }
+
     /// The registered name of this configuration.
     pub fn name(&self) -> String {
         if *self == Grid2Params::default() {

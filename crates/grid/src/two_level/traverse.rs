@@ -37,9 +37,11 @@ impl Grid2 {
         let mut probe = Probe::new(ray);
         top.level().walk(ray, t_enter, |u, t_exit| {
             c.cell();
-            if let Some(list) = top.cell_refs(u) {
+            // A cell with a grid of its own also keeps its list (for closest points): its
+            // offsets are not loaded.
+            if top.occupied(u) {
                 match self.grid_of[u] {
-                    0 => test_cell::<ANY_HIT, C>(list, top.triangles(), ray, &mut probe, c),
+                    0 => test_cell::<ANY_HIT, C>(top.list(u), top.triangles(), ray, &mut probe, c),
                     k => self.walk_grid::<ANY_HIT, C>(k, ray, &mut probe, c),
                 }
             }

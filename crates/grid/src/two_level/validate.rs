@@ -1,8 +1,7 @@
 //! The invariants of a built hierarchical grid, checked by tests after every build.
 
 use super::Grid2;
-use super::build::{cell_layout, could_pay, insert, may_subdivide, top_cell_box, worth_it};
-use crate::build::Layout;
+use super::build::{Inserted, own_grid};
 use raybench_geom::tribox::{MARGIN_REL, TriBox};
 use raybench_geom::{DVec3, TriangleMesh};
 
@@ -24,9 +23,9 @@ struct Cursor {
     plane: usize,
 }
 
-/// The top grid passes the uniform grid's checks; exactly the cells the rules give a grid of
-/// their own ([`may_subdivide`], [`cell_layout`]: a box holding every point of the cell's
-/// triangles within the enlarged cell) have one, with that layout, f32 planes and box rounded
+/// The top grid passes the uniform grid's checks; exactly the cells the build's rules give a
+/// grid of their own ([`own_grid`]: a box holding every point of the cell's triangles within
+/// the enlarged cell) have one, with that layout, f32 planes and box rounded
 /// from it, laid out depth first; the offsets tile the references and agree with the
 /// occupancy bits; a cell with a grid holds no list; and every cell's list (stored, or for a
 /// cell with a grid the one insertion gives it) is strictly ascending, holds only triangles of
@@ -57,23 +56,12 @@ pub(crate) fn validate(g: &Grid2, mesh: &TriangleMesh) -> Result<(), String> {
     let mut at = Cursor::default();
     for u in 0..top_cells {
         let list = g.top.cell_refs(u).unwrap_or_default();
-        let expected = may_subdivide(0, list.len(), &g.params)
-            .then(|| {
-                cell_layout(
-                    mesh,
-                    list,
-                    top_cell_box(&g.top, u),
-                    g.top.layout.margin,
-                    &g.params,
-                )
-            })
-            .flatten()
-            .filter(|l| could_pay(list.len(), l, &g.params))
-            .filter(|l| worth_it(insert(mesh, list, l).1.len(), list.len(), l, &g.params));
+        let cell = g.top.layout.cell_box(g.top.layout.coords(u));
+        let expected = own_grid(mesh, list, cell, g.top.layout.margin, 0, &g.params);
         match (expected, g.grid_of[u]) {
             (None, 0) => {}
-            (Some(layout), k) if k as usize == at.grid + 1 => {
-                check_grid(g, mesh, list, &layout, 1, &mut at)?
+            (Some(grid), k) if k as usize == at.grid + 1 => {
+                check_grid(g, mesh, list, &grid, 1, &mut at)?
             }
             (e, k) => {
                 return Err(format!(
@@ -96,16 +84,17 @@ pub(crate) fn validate(g: &Grid2, mesh: &TriangleMesh) -> Result<(), String> {
     Ok(())
 }
 
-/// Checks the grid at `at.grid`, built with `layout` at `level` over the triangles `list`, and
-/// then the grids of its cells.
+/// Checks the grid at `at.grid` against `expected` (a grid at `level` over the triangles
+/// `list`, as the build's rules make it), and then the grids of its cells.
 fn check_grid(
     g: &Grid2,
     mesh: &TriangleMesh,
     list: &[u32],
-    layout: &Layout,
+    expected: &Inserted,
     level: u32,
     at: &mut Cursor,
 ) -> Result<(), String> {
+    let layout = &expected.layout;
     let cg = *g.grids.get(at.grid).ok_or("grid index out of range")?;
     let name = at.grid;
     at.grid += 1;
@@ -116,7 +105,7 @@ fn check_grid(
         ));
     }
     for a in 0..3 {
-        let f32_planes: Vec<f32> = layout.planes[a].iter().map(|&p| p as f32).collect();
+        let f32_planes = layout.f32_planes(a);
         let start = cg.planes[a] as usize;
         if start != at.plane
             || g.planes.get(start..start + f32_planes.len()) != Some(&f32_planes[..])
@@ -137,7 +126,6 @@ fn check_grid(
     if at.cell > g.child.len() {
         return Err(format!("grid {name}: cells run past the arrays"));
     }
-    let (offsets, refs) = insert(mesh, list, layout);
     let mut children = Vec::new();
     let [nx, ny, nz] = layout.res;
     for z in 0..nz {
@@ -145,28 +133,10 @@ fn check_grid(
             for x in 0..nx {
                 let c = layout.index([x, y, z]);
                 let i = first + c;
-                let inserted = &refs[offsets[c] as usize..offsets[c + 1] as usize];
+                let inserted = expected.list(c);
                 let stored = &g.refs[g.offsets[i] as usize..g.offsets[i + 1] as usize];
-                let own = may_subdivide(level, inserted.len(), &g.params)
-                    .then(|| {
-                        cell_layout(
-                            mesh,
-                            inserted,
-                            layout.cell_box([x, y, z]),
-                            g.top.layout.margin,
-                            &g.params,
-                        )
-                    })
-                    .flatten()
-                    .filter(|l| could_pay(inserted.len(), l, &g.params))
-                    .filter(|l| {
-                        worth_it(
-                            insert(mesh, inserted, l).1.len(),
-                            inserted.len(),
-                            l,
-                            &g.params,
-                        )
-                    });
+                let cell = layout.cell_box([x, y, z]);
+                let own = own_grid(mesh, inserted, cell, g.top.layout.margin, level, &g.params);
                 let cell_list = match (own, g.child[i]) {
                     (None, 0) => stored,
                     (Some(l), k) if k != 0 => {
@@ -192,7 +162,7 @@ fn check_grid(
                 if cell_list.windows(2).any(|w| w[0] >= w[1]) {
                     return Err(format!("cell {i}: references not strictly ascending"));
                 }
-                let outer = widened(layout.cell_box([x, y, z]), TOLERANCE);
+                let outer = widened(cell, TOLERANCE);
                 for &id in cell_list {
                     if list.binary_search(&id).is_err() {
                         return Err(format!("cell {i}: triangle {id} is not in its parent cell"));
@@ -222,7 +192,7 @@ fn check_grid(
                     let c = layout.index([x, y, z]);
                     let i = first + c;
                     let cell_list = if g.child[i] != 0 {
-                        &refs[offsets[c] as usize..offsets[c + 1] as usize]
+                        expected.list(c)
                     } else {
                         &g.refs[g.offsets[i] as usize..g.offsets[i + 1] as usize]
                     };
@@ -233,14 +203,14 @@ fn check_grid(
             }
         }
     }
-    for (k, inserted, l) in children {
+    for (k, inserted, own) in children {
         if k as usize != at.grid + 1 {
             return Err(format!(
                 "a cell of grid {name} points at grid {k}, expected {}",
                 at.grid + 1
             ));
         }
-        check_grid(g, mesh, inserted, &l, level + 1, at)?;
+        check_grid(g, mesh, inserted, &own, level + 1, at)?;
     }
     Ok(())
 }

@@ -71,12 +71,17 @@ impl Scratch {
 /// Whether more than [`LARGE_LEAF`] of the node's triangles pass near one point, where no plane
 /// can cut them apart ([`super::is_pile`]).
 fn is_pile(ctx: &Ctx, ev: &Events) -> bool {
-    let ids: Vec<u32> = ev[0]
+    super::is_pile(ctx.tris, &triangles(ev))
+}
+
+/// The node's triangles: one start or planar event each on any axis (an end event follows
+/// its start).
+fn triangles(ev: &Events) -> Vec<u32> {
+    ev[0]
         .iter()
         .filter(|&&e| kind_of(e) != END)
         .map(|&e| tri_of(e))
-        .collect();
-    super::is_pile(ctx.tris, &ids)
+        .collect()
 }
 
 /// A chosen split.
@@ -135,12 +140,7 @@ fn node(
     let s = match chosen {
         Ok(s) => s,
         Err(stop) => {
-            let ids = ev[0]
-                .iter()
-                .filter(|&&e| kind_of(e) != END)
-                .map(|&e| tri_of(e))
-                .collect();
-            out.leaf(ctx, &cell, depth, ids, stop);
+            out.leaf(ctx, &cell, depth, triangles(&ev), stop);
             return;
         }
     };
