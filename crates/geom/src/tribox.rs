@@ -80,6 +80,12 @@ impl TriBox {
         }
     }
 
+    /// The corners (f64, exact).
+    #[inline]
+    pub fn vertices(&self) -> &[DVec3; 3] {
+        &self.v
+    }
+
     /// The triangle's bounding box (f64, exact).
     #[inline]
     pub fn bounds(&self) -> (DVec3, DVec3) {

@@ -2,8 +2,10 @@
 //!
 //! A cube around the scene is split recursively into eight octants at its centre while a node
 //! holds more than [`OctreeParams::max_obj`] triangles, down to at most
-//! [`OctreeParams::max_depth`] levels; each triangle goes into exactly the octants its exact
-//! triangle–box test ([`raybench_geom::tribox`]) says it overlaps ([`build`]). Nodes are
+//! [`OctreeParams::max_depth`] levels — by default a limit derived from the scene, deep enough
+//! for its smallest triangles ([`build::adaptive_depth_limit`]); each triangle goes into exactly
+//! the octants its exact triangle–box test ([`raybench_geom::tribox`]) says it overlaps
+//! ([`build`]; large nodes sort their triangles on both cores). Nodes are
 //! flattened into one array (the present children of a node contiguous, in octant order; empty
 //! octants are not stored) and one reference array. Rays visit the octants they pierce front to
 //! back — at each node the ray's crossings of the three centre planes, sorted, give the
@@ -36,8 +38,9 @@ pub struct OctreeParams {
     /// MAX_OBJ: a node with at most this many triangles is a leaf.
     pub max_obj: u32,
     /// MAX_DEPTH: nodes at this depth are leaves whatever they hold (at most
-    /// [`MAX_DEPTH_LIMIT`], which sizes the traversal stack).
-    pub max_depth: u32,
+    /// [`MAX_DEPTH_LIMIT`], which sizes the traversal stack). `None`: from the scene, one level
+    /// past the cells as small as its smallest triangle ([`build::adaptive_depth_limit`]).
+    pub max_depth: Option<u32>,
     /// Cost of visiting a node relative to one ray–triangle test, in the split rule: a node is
     /// split only when `traversal_cost + (references in its octants) / 4 < references`. A ray
     /// crossing a cube visits octants with 1/4 of its surface area each, so after a split it
@@ -57,12 +60,6 @@ pub struct OctreeParams {
 impl OctreeParams {
     /// 8: the customary value, not tuned.
     pub const MAX_OBJ: u32 = 8;
-    /// 20: deep enough to reach the teapot's own scale in the 1 km stadium (2^-20 of the
-    /// 1 km root is 1 mm; the teapot's triangles are a few mm). Most scenes stop on the split
-    /// rules well above it; conference reaches it too, with many references per triangle, the
-    /// open problem of this octree (measured: see docs/experiments.md, Uniform grid and
-    /// octree).
-    pub const MAX_DEPTH: u32 = 20;
     /// 8 GiB.
     pub const MEMORY_LIMIT: u64 = 8 << 30;
 
@@ -76,7 +73,9 @@ impl OctreeParams {
         } else {
             format!(
                 "octree-obj{}-depth{}-ct{}",
-                self.max_obj, self.max_depth, self.traversal_cost
+                self.max_obj,
+                self.max_depth.map_or("auto".into(), |d| d.to_string()),
+                self.traversal_cost
             )
         }
     }
@@ -86,7 +85,7 @@ impl Default for OctreeParams {
     fn default() -> Self {
         OctreeParams {
             max_obj: OctreeParams::MAX_OBJ,
-            max_depth: OctreeParams::MAX_DEPTH,
+            max_depth: None,
             traversal_cost: raybench_accel::SAH_TRAVERSAL_COST as f32,
             memory_limit_bytes: OctreeParams::MEMORY_LIMIT,
             parallel_threshold: 4096,
@@ -100,6 +99,8 @@ impl Default for OctreeParams {
 pub struct Octree {
     name: String,
     params: OctreeParams,
+    /// The MAX_DEPTH the build used: the user's, or the one it derived from the scene.
+    depth_limit: u32,
     root_box: Aabb,
     nodes: Vec<Node>,
     refs: Vec<u32>,
@@ -119,6 +120,11 @@ impl Octree {
         &self.nodes
     }
 
+    /// The MAX_DEPTH the build used.
+    pub fn depth_limit(&self) -> u32 {
+        self.depth_limit
+    }
+
     pub fn root_box(&self) -> Aabb {
         self.root_box
     }
@@ -133,7 +139,7 @@ impl Accel for Octree {
     type Params = OctreeParams;
 
     fn build(mesh: Arc<TriangleMesh>, params: &OctreeParams) -> Result<Octree, BuildError> {
-        if params.max_depth > MAX_DEPTH_LIMIT {
+        if params.max_depth.is_some_and(|d| d > MAX_DEPTH_LIMIT) {
             return Err(BuildError::Unsupported(format!(
                 "max_depth <= {MAX_DEPTH_LIMIT} (got {params:?})"
             )));

@@ -6,7 +6,7 @@ use std::ops::Range;
 
 /// Deepest tree the traversal stack is sized for. A pop of an interior node pushes at most four
 /// children, so the stack never holds more than three waiting siblings per level plus one.
-pub const MAX_DEPTH_LIMIT: u32 = 24;
+pub const MAX_DEPTH_LIMIT: u32 = 32;
 pub(crate) const STACK: usize = 3 * MAX_DEPTH_LIMIT as usize + 2;
 
 const LEAF: u32 = 1 << 31;

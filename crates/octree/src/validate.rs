@@ -2,7 +2,7 @@
 
 use crate::Octree;
 use crate::build::{enlarged, root_box};
-use crate::node::{child_box, mid};
+use crate::node::{MAX_DEPTH_LIMIT, child_box, mid};
 use raybench_geom::tribox::TriBox;
 use raybench_geom::{MollerTriangle, TriangleMesh, Vec3};
 
@@ -24,6 +24,16 @@ pub(crate) fn validate(tree: &Octree, mesh: &TriangleMesh) -> Result<(), String>
         if *t != MollerTriangle::new(&mesh.triangle(i)) {
             return Err(format!("triangle copy {i} is not mesh triangle {i}"));
         }
+    }
+    let limit_ok = match tree.params.max_depth {
+        Some(d) => tree.depth_limit == d,
+        None => tree.depth_limit <= MAX_DEPTH_LIMIT,
+    };
+    if !limit_ok {
+        return Err(format!(
+            "depth limit {} for MAX_DEPTH {:?} (at most {MAX_DEPTH_LIMIT})",
+            tree.depth_limit, tree.params.max_depth
+        ));
     }
     let expected_root = root_box(&mesh.bounds());
     if tree.root_box != expected_root {
@@ -82,10 +92,10 @@ struct Walk<'a> {
 impl Walk<'_> {
     fn node(&mut self, at: usize, lo: Vec3, hi: Vec3, depth: u32) -> Result<(), String> {
         let tree = self.tree;
-        if depth > tree.params.max_depth {
+        if depth > tree.depth_limit {
             return Err(format!(
                 "node {at} at depth {depth} beyond MAX_DEPTH {}",
-                tree.params.max_depth
+                tree.depth_limit
             ));
         }
         let reached = self

@@ -26,16 +26,16 @@ fn extreme_knobs_conform() {
     // the serial build path.
     check(OctreeParams {
         max_obj: 1,
-        max_depth: raybench_octree::MAX_DEPTH_LIMIT,
+        max_depth: Some(raybench_octree::MAX_DEPTH_LIMIT),
         ..OctreeParams::default()
     });
     check(OctreeParams {
-        max_depth: 0,
+        max_depth: Some(0),
         ..OctreeParams::default()
     });
     check(OctreeParams {
         max_obj: 64,
-        max_depth: 3,
+        max_depth: Some(3),
         parallel_threshold: u32::MAX,
         ..OctreeParams::default()
     });
@@ -133,11 +133,11 @@ fn point_queries_conform() {
         // One triangle per leaf as deep as allowed, and a single leaf.
         OctreeParams {
             max_obj: 1,
-            max_depth: raybench_octree::MAX_DEPTH_LIMIT,
+            max_depth: Some(raybench_octree::MAX_DEPTH_LIMIT),
             ..OctreeParams::default()
         },
         OctreeParams {
-            max_depth: 0,
+            max_depth: Some(0),
             ..OctreeParams::default()
         },
     ] {
@@ -155,4 +155,50 @@ fn point_queries_conform_on_the_shared_scenes() {
         30,
     );
     eprintln!("real scenes checked: {checked}");
+}
+
+// ---- The depth limit adapts to the scene ----------------------------------------------------
+
+#[test]
+fn a_tiny_teapot_in_a_stadium_is_subdivided_to_its_own_scale() {
+    // A 1 cm teapot in a 1 km stadium: cells of the textbook MAX_DEPTH (2^-20 of the root,
+    // about 1 mm) still hold hundreds of its triangles; the adaptive limit goes deeper.
+    let spec = "teapot-in-stadium:size_ratio=1e-5,stadium_triangles=4000,teapot_triangles=6000";
+    let scene = raybench_testkit::scenes::generate(spec, 1).unwrap();
+    let mesh = scene.mesh.clone();
+    let crowded = |t: &Octree| t.build_stats().extra["leaves_over_64_not_sharing_a_point"];
+    let fixed = OctreeParams {
+        max_depth: Some(20),
+        ..OctreeParams::default()
+    };
+    let shallow = Octree::build(mesh.clone(), &fixed).unwrap();
+    shallow.validate(&mesh).unwrap();
+    assert_eq!(shallow.depth_limit(), 20);
+    assert!(crowded(&shallow) > 0.0, "{:?}", shallow.build_stats());
+    let params = OctreeParams::default();
+    let tree = Octree::build(mesh.clone(), &params).unwrap();
+    tree.validate(&mesh).unwrap();
+    assert!(tree.depth_limit() > 20, "{}", tree.depth_limit());
+    assert_eq!(crowded(&tree), 0.0, "{:?}", tree.build_stats());
+    // And the answers, for camera rays at the teapot.
+    let [rays, _] = raybench_testkit::camera_ray_sets(&scene, 2000);
+    let case = raybench_testkit::Case {
+        name: spec.into(),
+        seed: 1,
+        mesh: mesh.clone(),
+        rays,
+    };
+    let counts = raybench_testkit::check_case::<Octree>(&case, &params, &|t, m| t.validate(m))
+        .unwrap_or_else(|e| panic!("{spec}: {e}"));
+    assert_eq!(counts.mismatch, 0);
+}
+
+#[test]
+fn the_depth_limit_never_falls_below_the_textbook_one() {
+    // Needles as long as the scene: its smallest triangle alone would allow 2 levels.
+    let mesh = generated("fan:triangles=2000", 1);
+    let tree = Octree::build(mesh.clone(), &OctreeParams::default()).unwrap();
+    tree.validate(&mesh).unwrap();
+    assert_eq!(tree.depth_limit(), raybench_octree::build::DEPTH_FLOOR);
+    assert!(tree.build_stats().max_depth > 2, "{:?}", tree.build_stats());
 }
