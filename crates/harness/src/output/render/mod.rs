@@ -13,10 +13,13 @@
 
 pub mod charts;
 mod figures;
+pub mod fit;
 pub mod names;
 mod page;
+pub mod palette;
 pub mod pictures;
 mod scaling;
+pub mod ticks;
 
 use crate::atomic::write_atomic;
 use crate::report::run::{Report, ResultEntry};
