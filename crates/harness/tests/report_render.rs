@@ -4,6 +4,7 @@
 
 mod common;
 
+use raybench_harness::output::render::sweep::Sweep;
 use raybench_harness::output::render::{pictures, render};
 use raybench_harness::pipeline::run::run;
 use raybench_harness::report::run::Report;
@@ -12,7 +13,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-/// Three sphere sizes (so the scaling chart appears), two structures with counters and Embree.
+/// Three sphere sizes (so the scaling chart appears) and a plane (so the report sweeps no
+/// parameter and keeps its bar charts), two structures with counters and Embree.
 fn report() -> &'static Report {
     static REPORT: OnceLock<Report> = OnceLock::new();
     REPORT.get_or_init(|| {
@@ -25,6 +27,7 @@ fn report() -> &'static Report {
             "sphere:triangles=500",
             "sphere:triangles=2000",
             "sphere:triangles=8000",
+            "plane:quads=8",
         ]
         .map(|s| SceneRequest::Spec(s.into()));
         run(&options, &scenes).unwrap()
@@ -65,6 +68,29 @@ fn every_chart_type_is_drawn() {
             "{file} draws nothing"
         );
     }
+}
+
+/// A report of unrelated scenes is no sweep: bars per scene, each group labelled with its
+/// scene and naming it in full on hover, the legend right of the plot.
+#[test]
+fn a_report_without_a_sweep_draws_bars_labelled_by_scene() {
+    assert_eq!(Sweep::detect(report()), None);
+    let svg = std::fs::read_to_string(rendered().join("charts/mrays-random.svg")).unwrap();
+    for scene in ["sphere:triangles=500", "plane:quads=8"] {
+        assert!(
+            svg.contains(&format!("<title>{scene}</title>{scene}</text>")),
+            "{scene} is not a group label with its hover title"
+        );
+    }
+    // A bar per scene and structure (4 × 3), each with a hover rectangle, and one hover
+    // rectangle per group.
+    let bars = svg
+        .lines()
+        .filter(|l| l.starts_with("<rect") && l.contains("opacity=\"1\""))
+        .count();
+    assert_eq!(bars, 1 + 12, "the background and twelve bars");
+    assert_eq!(svg.matches("fill-opacity=\"0\"><title>").count(), 4 + 12);
+    assert!(svg.contains("<title>bvh-binned, sphere:triangles=2000: "));
 }
 
 fn decode(path: &Path) -> (u32, u32, Vec<u8>) {

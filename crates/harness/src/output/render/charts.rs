@@ -1,34 +1,21 @@
-//! SVG charts drawn with plotters. Text is emitted as SVG `<text>` (plotters' naive font), so no
-//! font files are read at build or run time. Two shapes cover every chart: grouped bars (groups
-//! on x, one bar per series) and lines on log–log axes.
+//! SVG charts drawn with plotters. Text is emitted as SVG `<text>` (plotters' naive font, and
+//! the [`Overlay`]'s own), so no font files are read at build or run time. Two shapes cover
+//! every chart: grouped bars (groups on x, one bar per series), here, and lines
+//! ([`super::lines`]). Both keep their legend in a column right of the plot.
 
+use super::legend::{self, Entry, LEGEND_W, Swatch};
+use super::overlay::{LabelLayout, Overlay, text_width};
+use super::ticks::{axis_ticks, tick_label};
 use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 
-/// A categorical palette (Tableau 10), cycled.
-const PALETTE: [RGBColor; 10] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
-];
-
-pub fn color(i: usize) -> RGBColor {
-    PALETTE[i % PALETTE.len()]
-}
-
 /// One named series of values, one per group (`None`: no bar).
 #[derive(Clone, Debug)]
 pub struct Series {
     pub name: String,
+    pub color: RGBColor,
     pub values: Vec<Option<f64>>,
 }
 
@@ -37,7 +24,10 @@ pub struct Series {
 pub struct Bars {
     pub title: String,
     pub y_desc: String,
+    /// The label under each group.
     pub groups: Vec<String>,
+    /// Each group's full name, shown on hover (empty: the labels).
+    pub group_titles: Vec<String>,
     pub series: Vec<Series>,
     pub log_y: bool,
 }
@@ -54,52 +44,61 @@ impl Bars {
             .flat_map(|s| s.values.iter().flatten().copied())
             .filter(|v| v.is_finite() && *v > 0.0)
     }
+
+    fn group_title(&self, g: usize) -> &str {
+        self.group_titles.get(g).unwrap_or(&self.groups[g]).as_str()
+    }
 }
 
-fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+pub(super) fn plot_err<E: std::fmt::Display>(e: E) -> anyhow::Error {
     anyhow!("drawing a chart: {e}")
 }
 
 /// Renders one chart to an SVG string.
 pub fn bars_svg(chart: &Bars, width: u32, height: u32) -> Result<String> {
-    panels_svg(std::slice::from_ref(chart), width, height, |a, c| {
-        draw_bars(a, c)
+    panels_svg(std::slice::from_ref(chart), width, height, |a, c, o| {
+        draw_bars(a, c, o)
     })
 }
 
 /// Several charts stacked vertically in one SVG (e.g. the three counters of a workload).
 #[allow(clippy::redundant_closure)]
 pub fn stacked_bars_svg(charts: &[Bars], width: u32, panel_height: u32) -> Result<String> {
-    panels_svg(charts, width, panel_height, |a, c| draw_bars(a, c))
+    panels_svg(charts, width, panel_height, |a, c, o| draw_bars(a, c, o))
 }
 
-/// One SVG of `panel_height`-high panels stacked vertically, each drawn by `draw`. Callers pass
-/// closures, not the generic draw functions themselves: those are instantiated for one
-/// backend lifetime, and `draw` must accept any (clippy's `redundant_closure` is wrong here).
-fn panels_svg<T>(
+/// One SVG of `panel_height`-high panels stacked vertically, each drawn by `draw`, which may
+/// add to one [`Overlay`] drawn over the whole. Callers pass closures, not the generic draw
+/// functions themselves: those are instantiated for one backend lifetime, and `draw` must
+/// accept any (clippy's `redundant_closure` is wrong here).
+pub(super) fn panels_svg<T>(
     charts: &[T],
     width: u32,
     panel_height: u32,
-    draw: impl Fn(&DrawingArea<SVGBackend, Shift>, &T) -> Result<()>,
+    draw: impl Fn(&DrawingArea<SVGBackend, Shift>, &T, &mut Overlay) -> Result<()>,
 ) -> Result<String> {
     let mut svg = String::new();
+    let mut overlay = Overlay::default();
     {
         let height = panel_height * charts.len().max(1) as u32;
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
         let panels = root.split_evenly((charts.len().max(1), 1));
         for (panel, chart) in panels.iter().zip(charts) {
-            draw(panel, chart)?;
+            draw(panel, chart, &mut overlay)?;
         }
         root.present().map_err(plot_err)?;
     }
-    Ok(svg)
+    Ok(overlay.apply(svg))
 }
 
-fn short(label: &str) -> String {
-    let label = label.trim_end_matches(".obj");
-    if label.chars().count() > 18 {
-        format!("{}…", label.chars().take(17).collect::<String>())
+/// Longest label drawn under a group; longer ones are cut with "…" (the full name stays in
+/// the hover title).
+const MAX_LABEL: usize = 28;
+
+fn cut(label: &str) -> String {
+    if label.chars().count() > MAX_LABEL {
+        format!("{}…", label.chars().take(MAX_LABEL - 1).collect::<String>())
     } else {
         label.to_string()
     }
@@ -117,8 +116,14 @@ fn on_axis(v: f64) -> f64 {
 }
 
 /// Bars for group `g`, series `s` span `[g - 0.4, g + 0.4]` split evenly between the series;
-/// x runs from -0.5 so that the integer ticks fall on group centres and carry their names.
-fn draw_bars<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &Bars) -> Result<()> {
+/// x runs from -0.5 so that group `g` is centred on `g`.
+fn draw_bars<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    c: &Bars,
+    o: &mut Overlay,
+) -> Result<()> {
+    let (w, h) = area.dim_in_pixel();
+    let (plot, side) = area.split_horizontally(w.saturating_sub(LEGEND_W));
     let n = c.groups.len().max(1);
     let values: Vec<f64> = c.positive_values().collect();
     let (lo, hi) = values
@@ -131,88 +136,141 @@ fn draw_bars<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &Bars) -> Res
     } else {
         (on_axis(lo), on_axis(hi))
     };
-    let groups = c.groups.clone();
-    let x_fmt = move |x: &f64| {
-        let i = x.round();
-        if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < groups.len() {
-            short(&groups[i as usize])
-        } else {
-            String::new()
-        }
-    };
+    let labels: Vec<String> = c.groups.iter().map(|g| cut(g)).collect();
+    let plot_w = (w.saturating_sub(LEGEND_W) as f64 - 80.0 - 24.0).max(50.0);
+    let widest = labels.iter().map(|l| text_width(l)).fold(0.0, f64::max);
+    let layout = LabelLayout::for_labels(widest, plot_w / n as f64);
     let x_range = -0.5..(n as f64 - 0.5);
+    let geometry = (layout, labels.as_slice());
     if c.log_y {
-        // Headroom above the tallest bar for the legend box; bars rise from below the lowest.
-        let top = hi * 2.0 * (hi / lo * 4.0).max(4.0).powf(0.35);
+        let (bottom, top) = (lo / 2.0, (hi * 2.0).min(AXIS_MAX * 2.0));
         bars_on(
-            area,
+            &plot,
             c,
-            x_range,
-            ((lo / 2.0)..top).log_scale(),
-            lo / 2.0,
-            &x_fmt,
-        )
+            o,
+            (x_range, (bottom..top).log_scale()),
+            bottom,
+            geometry,
+        )?;
     } else {
-        bars_on(area, c, x_range, 0.0..(hi * 1.45).max(1e-9), 0.0, &x_fmt)
+        bars_on(
+            &plot,
+            c,
+            o,
+            (x_range, 0.0..(hi * 1.1).max(1e-9)),
+            0.0,
+            geometry,
+        )?;
     }
+    let (sx, sy) = side.get_base_pixel();
+    let entries: Vec<Entry> = c
+        .series
+        .iter()
+        .map(|s| Entry {
+            label: s.name.clone(),
+            swatch: Swatch::Block(s.color),
+        })
+        .collect();
+    legend::draw(
+        o,
+        (sx as f64 + 8.0, sy as f64 + 40.0),
+        h as f64 - 60.0,
+        &entries,
+    );
+    Ok(())
 }
 
 /// Draws `c` with a linear or logarithmic y axis (`y_range`); bars start at `base`.
 fn bars_on<DB, Y>(
     area: &DrawingArea<DB, Shift>,
     c: &Bars,
-    x_range: std::ops::Range<f64>,
-    y_range: Y,
+    o: &mut Overlay,
+    (x_range, y_range): (std::ops::Range<f64>, Y),
     base: f64,
-    x_fmt: &dyn Fn(&f64) -> String,
+    (layout, labels): (LabelLayout, &[String]),
 ) -> Result<()>
 where
     DB: DrawingBackend,
     Y: AsRangedCoord<Value = f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
-    let n = c.groups.len().max(1);
+    let widest = labels.iter().map(|l| text_width(l)).fold(0.0, f64::max);
     let mut chart = ChartBuilder::on(area)
         .caption(&c.title, ("sans-serif", 18))
         .margin(12)
-        .x_label_area_size(40)
+        .x_label_area_size(layout.height(widest) as u32 + 4)
         .y_label_area_size(80)
         .build_cartesian_2d(x_range, y_range)
         .map_err(plot_err)?;
     chart
         .configure_mesh()
         .disable_x_mesh()
-        .x_labels(n + 1)
-        .x_label_formatter(x_fmt)
-        .x_label_style(("sans-serif", 11))
+        .disable_y_mesh()
+        .x_labels(0)
+        .y_labels(0)
+        .set_all_tick_mark_size(0)
+        // The ticks are drawn with the overlay; plotters' log axis labels a decade anyway.
+        .y_label_formatter(&|_| String::new())
         .y_desc(c.y_desc.as_str())
-        .y_label_formatter(&|y| format_value(*y))
+        .label_style(("sans-serif", 13))
         .draw()
         .map_err(plot_err)?;
+    let top = chart.y_range().end;
+    let (left, right) = {
+        let (xs, _) = chart.plotting_area().get_pixel_range();
+        (xs.start as f64, xs.end as f64)
+    };
+    let y_ticks: Vec<(f64, String)> = axis_ticks(base, top, c.log_y)
+        .into_iter()
+        .map(|y| (chart.backend_coord(&(0.0, y)).1 as f64, tick_label(y)))
+        .collect();
+    o.y_axis(&y_ticks, left, right);
+    // Hovering anywhere over a group names its scene; over a bar, also the value.
+    for g in 0..c.groups.len() {
+        let a = chart.backend_coord(&(g as f64 - 0.5, top));
+        let b = chart.backend_coord(&(g as f64 + 0.5, base));
+        o.hover_rect(
+            (a.0 as f64, a.1 as f64),
+            (b.0 as f64, b.1 as f64),
+            c.group_title(g),
+        );
+    }
     let width = 0.8 / c.series.len().max(1) as f64;
     for (s, series) in c.series.iter().enumerate() {
-        let col = color(s);
-        let rects = bar_rects(series, s, width, base);
-        chart
-            .draw_series(rects.into_iter().map(|r| Rectangle::new(r, col.filled())))
-            .map_err(plot_err)?
-            .label(series.name.as_str())
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], col.filled()));
+        let col = series.color;
+        for (g, rect) in bar_rects(series, s, width, base) {
+            chart
+                .draw_series(std::iter::once(Rectangle::new(rect, col.filled())))
+                .map_err(plot_err)?;
+            let a = chart.backend_coord(&rect[0]);
+            let b = chart.backend_coord(&rect[1]);
+            let value = series.values[g].unwrap_or_default();
+            o.hover_rect(
+                (a.0 as f64, b.1 as f64),
+                (b.0 as f64, a.1 as f64),
+                &format!(
+                    "{}, {}: {} {}",
+                    series.name,
+                    c.group_title(g),
+                    tick_label(value),
+                    c.y_desc
+                ),
+            );
+        }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 11))
-        .draw()
-        .map_err(plot_err)?;
+    for (g, label) in labels.iter().enumerate().step_by(layout.step) {
+        let (px, py) = chart.backend_coord(&(g as f64, base));
+        let (px, py) = (px as f64, py as f64);
+        o.line((px, py), (px, py + 5.0), BLACK, 1.0, None);
+        layout.draw(o, (px, py), label, Some(c.group_title(g)));
+    }
     Ok(())
 }
 
 type Rect = [(f64, f64); 2];
 
-fn bar_rects(series: &Series, s: usize, width: f64, base: f64) -> Vec<Rect> {
+/// The bars of series `s`, each with its group.
+fn bar_rects(series: &Series, s: usize, width: f64, base: f64) -> Vec<(usize, Rect)> {
     series
         .values
         .iter()
@@ -221,140 +279,8 @@ fn bar_rects(series: &Series, s: usize, width: f64, base: f64) -> Vec<Rect> {
             let v = (*v)?;
             (v.is_finite() && v > 0.0).then(|| {
                 let x0 = g as f64 - 0.4 + s as f64 * width;
-                [(x0, base), (x0 + width * 0.9, on_axis(v))]
+                (g, [(x0, base), (x0 + width * 0.9, on_axis(v))])
             })
         })
         .collect()
-}
-
-/// Short numbers for axis labels: 0.001, 0.25, 12, 3.4k, 2.1M.
-pub fn format_value(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 {
-        "0".into()
-    } else if a >= 1e6 {
-        format!("{:.3}M", v / 1e6)
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-            .to_string()
-    } else if a >= 1e3 {
-        format!("{:.3}k", v / 1e3)
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-            .to_string()
-    } else if a >= 1.0 {
-        let s = format!("{v:.3}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        format!("{v:.2e}")
-    }
-}
-
-/// A line chart on log–log axes: measured series (solid, with points) and reference curves
-/// (dashed grey, labelled in the legend).
-#[derive(Clone, Debug)]
-pub struct LogLog {
-    pub title: String,
-    pub x_desc: String,
-    pub y_desc: String,
-    pub series: Vec<(String, Vec<(f64, f64)>)>,
-    pub references: Vec<(String, Vec<(f64, f64)>)>,
-}
-
-impl LogLog {
-    pub fn has_data(&self) -> bool {
-        self.series
-            .iter()
-            .any(|(_, p)| p.iter().any(|&(x, y)| ok(x) && ok(y)))
-    }
-}
-
-fn ok(v: f64) -> bool {
-    v.is_finite() && v > 0.0
-}
-
-#[allow(clippy::redundant_closure)]
-pub fn loglog_svg(charts: &[LogLog], width: u32, panel_height: u32) -> Result<String> {
-    panels_svg(charts, width, panel_height, |a, c| draw_loglog(a, c))
-}
-
-fn draw_loglog<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, c: &LogLog) -> Result<()> {
-    let points: Vec<(f64, f64)> = c
-        .series
-        .iter()
-        .chain(&c.references)
-        .flat_map(|(_, p)| p.iter().copied())
-        .filter(|&(x, y)| ok(x) && ok(y))
-        .collect();
-    let (mut x0, mut x1, mut y0, mut y1) = points.iter().fold(
-        (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        ),
-        |(a, b, c, d), &(x, y)| (a.min(x), b.max(x), c.min(y), d.max(y)),
-    );
-    if points.is_empty() {
-        (x0, x1, y0, y1) = (1.0, 10.0, 1.0, 10.0);
-    }
-    let (x0, x1, y0, y1) = (on_axis(x0), on_axis(x1), on_axis(y0), on_axis(y1));
-    let mut chart = ChartBuilder::on(area)
-        .caption(&c.title, ("sans-serif", 18))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(80)
-        .build_cartesian_2d(
-            ((x0 / 1.5)..(x1 * 1.5)).log_scale(),
-            ((y0 / 2.0)..(y1 * 2.0)).log_scale(),
-        )
-        .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_desc(c.x_desc.as_str())
-        .y_desc(c.y_desc.as_str())
-        .x_label_formatter(&|x| format_value(*x))
-        .y_label_formatter(&|y| format_value(*y))
-        .draw()
-        .map_err(plot_err)?;
-    for (i, (name, pts)) in c.series.iter().enumerate() {
-        let col = color(i);
-        let pts: Vec<(f64, f64)> = pts
-            .iter()
-            .filter(|&&(x, y)| ok(x) && ok(y))
-            .map(|&(x, y)| (on_axis(x), on_axis(y)))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
-            .map_err(plot_err)?
-            .label(name.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], col.stroke_width(2)));
-        chart
-            .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, col.filled())))
-            .map_err(plot_err)?;
-    }
-    for (i, (name, pts)) in c.references.iter().enumerate() {
-        let grey = RGBColor(120 + 25 * (i as u8 % 4), 120, 120);
-        let pts: Vec<(f64, f64)> = pts
-            .iter()
-            .filter(|&&(x, y)| ok(x) && ok(y))
-            .map(|&(x, y)| (on_axis(x), on_axis(y)))
-            .collect();
-        chart
-            .draw_series(DashedLineSeries::new(pts, 6, 4, grey.stroke_width(1)))
-            .map_err(plot_err)?
-            .label(name.as_str())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 14, y)], grey.stroke_width(1))
-            });
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 11))
-        .draw()
-        .map_err(plot_err)?;
-    Ok(())
 }

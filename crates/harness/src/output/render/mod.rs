@@ -2,23 +2,31 @@
 //!
 //! Output layout under the chosen directory:
 //! * `charts/*.svg` — build time, Mrays/s (Mqueries/s for closest-point workloads) and ratios
-//!   to the reference per workload, memory per triangle, counters per query, scaling curves
-//!   with reference slopes (when one scene family comes in three or more sizes), break-even per
-//!   scene, validation classes;
+//!   to the reference per workload, memory per triangle, counters per query (bars per scene, or
+//!   lines against the swept parameter when the report is a sweep), scaling curves with fitted
+//!   exponents and theory slopes (when the scenes grow), break-even per scene, validation
+//!   classes; one colour per structure throughout;
 //! * `images/*.png` — per scene and structure: traversal-cost heatmap (one colour scale per
 //!   scene), shaded render, disagreement mask; one legend colour bar;
-//! * `index.html` — tables, the charts, the pictures and the environment; no JavaScript.
+//! * `index.html` — tables (with the fitted exponents of a size sweep), the charts, the
+//!   pictures and the environment; no JavaScript.
 //!
 //! Every file is written atomically (a temporary file, then a rename).
 
+mod break_even;
 pub mod charts;
 mod figures;
 pub mod fit;
+mod legend;
+pub mod lines;
 pub mod names;
+mod overlay;
 mod page;
 pub mod palette;
 pub mod pictures;
 mod scaling;
+pub mod sweep;
+mod sweep_charts;
 pub mod ticks;
 
 use crate::atomic::write_atomic;
@@ -26,7 +34,9 @@ use crate::report::run::{Report, ResultEntry};
 use anyhow::{Context, Result};
 use figures::all_charts;
 use names::{scene_names, scene_slugs, slug};
+use scaling::{Exponents, Sizes};
 use std::path::{Path, PathBuf};
+use sweep::Sweep;
 
 /// Chart size in pixels (SVG user units).
 const W: u32 = 1100;
@@ -64,7 +74,8 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
         .with_context(|| format!("creating {}", dir.display()))?;
     let mut out = Rendered::default();
     let mut chart_files = Vec::new();
-    for (file, caption, svg) in all_charts(report)? {
+    let sweep = Sweep::detect(report);
+    for (file, caption, svg) in all_charts(report, sweep.as_ref())? {
         let path = dir.join("charts").join(&file);
         write_atomic(&path, svg.as_bytes())?;
         out.charts.push(path);
@@ -74,7 +85,16 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
         });
     }
     let pictures = write_pictures(report, dir, &mut out.images)?;
-    let page = page::page(report, &chart_files, &pictures);
+    let exponents = Sizes::of(report, sweep.as_ref()).map(|sizes| Exponents::of(report, &sizes));
+    let page = page::page(
+        report,
+        &page::Extras {
+            charts: &chart_files,
+            pictures: &pictures,
+            sweep: sweep.as_ref(),
+            exponents: exponents.as_ref(),
+        },
+    );
     out.index = dir.join("index.html");
     write_atomic(&out.index, page.as_bytes())?;
     Ok(out)

@@ -1,7 +1,11 @@
 //! `index.html`: one static page (no JavaScript) with the tables, charts, pictures and the
 //! environment fingerprint of a report.
 
+use super::fit::PowerFit;
 use super::names::{scene_names, structure_names, workload_names};
+use super::scaling::Exponents;
+use super::sweep::Sweep;
+use super::ticks::tick_label;
 use super::{ChartFile, ScenePictures};
 use crate::report::run::{Report, throughput_unit};
 use std::fmt::Write as _;
@@ -22,7 +26,17 @@ img.chart{max-width:100%;border:1px solid #ddd}\
 img.px{image-rendering:pixelated;width:240px;border:1px solid #ddd}\
 .bad{color:#c00;font-weight:bold}.note{color:#555;font-size:13px}";
 
-pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictures]) -> String {
+/// What the page shows beside the report itself.
+pub(crate) struct Extras<'a> {
+    pub charts: &'a [ChartFile],
+    pub pictures: &'a [ScenePictures],
+    /// The parameter the report sweeps, if any.
+    pub sweep: Option<&'a Sweep>,
+    /// Fitted exponents against N, when the scenes grow.
+    pub exponents: Option<&'a Exponents>,
+}
+
+pub(crate) fn page(report: &Report, extras: &Extras) -> String {
     let mut s = String::new();
     let env = &report.header.environment;
     let title = match &report.run.suite {
@@ -56,10 +70,16 @@ pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictu
             .map(|w| w.agreement.queries())
             .sum::<u64>()
     );
+    if let Some(sweep) = extras.sweep {
+        sweep_note(&mut s, sweep);
+    }
     results_table(&mut s, report);
     agreement_table(&mut s, report);
+    if let Some(e) = extras.exponents {
+        exponents_table(&mut s, e);
+    }
     s.push_str("<h2>Charts</h2>\n");
-    for c in charts {
+    for c in extras.charts {
         let _ = writeln!(
             s,
             "<figure><img class=\"chart\" src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
@@ -68,7 +88,7 @@ pub(crate) fn page(report: &Report, charts: &[ChartFile], pictures: &[ScenePictu
             escape(&c.caption)
         );
     }
-    pictures_section(&mut s, pictures);
+    pictures_section(&mut s, extras.pictures);
     notes(&mut s, report);
     environment(&mut s, report);
     s.push_str("</body></html>\n");
@@ -133,6 +153,67 @@ fn results_table(s: &mut String, report: &Report) {
                 if bad > 0 { " class=\"bad\"" } else { "" }
             );
         }
+    }
+    s.push_str("</table>\n");
+}
+
+fn sweep_note(s: &mut String, sweep: &Sweep) {
+    let (first, last) = (&sweep.points[0], &sweep.points[sweep.points.len() - 1]);
+    let _ = writeln!(
+        s,
+        "<p>A sweep of <b>{}</b> in <code>{}</code>, {} scenes from {} to {}: the per-scene \
+         charts draw each structure as a line against it{}.</p>",
+        escape(&sweep.key),
+        escape(&sweep.generator),
+        sweep.points.len(),
+        escape(&tick_label(first.value)),
+        escape(&tick_label(last.value)),
+        if sweep.log_x() {
+            " on a logarithmic axis"
+        } else {
+            ""
+        }
+    );
+}
+
+/// Each structure's exponent b of `∝ N^b` per quantity, with its 95 % interval.
+fn exponents_table(s: &mut String, e: &Exponents) {
+    let n = &e.sizes.scenes;
+    let _ = writeln!(
+        s,
+        "<h2>Scaling exponents</h2>\n<p class=\"note\">Each quantity fitted as ∝ N<sup>b</sup> by \
+         least squares on log–log axes over the {} scenes of <code>{}</code> (N = {} to {} \
+         triangles); ± is the 95 % confidence interval (the slope's standard error × Student's t, \
+         n − 2 degrees of freedom). Theory: log N gives b ≈ 0 (slightly above over a finite \
+         range), N<sup>1/3</sup> (a uniform grid's cells along a ray) b = 0.33, N (brute force) \
+         b = 1; a build in N log N shows b a little above 1.</p>",
+        n.len(),
+        escape(&e.sizes.family),
+        tick_label(n[0].1),
+        tick_label(n[n.len() - 1].1)
+    );
+    s.push_str("<table><tr><th class=\"l\">structure</th><th>build time</th>");
+    for w in &e.workloads {
+        let _ = write!(
+            s,
+            "<th>{} time per query</th><th>{} triangle tests per query</th>",
+            escape(w),
+            escape(w)
+        );
+    }
+    s.push_str("</tr>\n");
+    let cell = |f: &Option<PowerFit>| f.map_or("-".to_string(), |f| f.text());
+    for row in &e.rows {
+        let _ = write!(
+            s,
+            "<tr><td class=\"l\">{}</td><td>{}</td>",
+            escape(&row.structure),
+            cell(&row.build)
+        );
+        for (time, tests) in &row.per_workload {
+            let _ = write!(s, "<td>{}</td><td>{}</td>", cell(time), cell(tests));
+        }
+        s.push_str("</tr>\n");
     }
     s.push_str("</table>\n");
 }
