@@ -381,12 +381,13 @@ fn counters_text(w: &WorkloadResult) -> String {
     match &w.counters_per_query {
         None => "none".into(),
         Some(c) => format!(
-            "nodes {:.3}, leaves {:.3}, prim tests {:.3}, cells {:.3}, mailbox skips {:.3} per {}",
+            "nodes {:.3}, leaves {:.3}, prim tests {:.3}, cells {:.3}, mailbox skips {:.3}, jumps {:.3} per {}",
             c.nodes,
             c.leaves,
             c.prim_tests,
             c.cells,
             c.mailbox_skips,
+            c.jumps,
             if w.point_query { "query" } else { "ray" }
         ),
     }

@@ -160,6 +160,9 @@ pub struct CountersPerQuery {
     pub prim_tests: f64,
     pub cells: f64,
     pub mailbox_skips: f64,
+    /// Absent in reports written before jumps were counted: 0.
+    #[serde(default)]
+    pub jumps: f64,
 }
 
 impl CountersPerQuery {
@@ -171,6 +174,7 @@ impl CountersPerQuery {
             prim_tests: c.prim_tests as f64 / n,
             cells: c.cells as f64 / n,
             mailbox_skips: c.mailbox_skips as f64 / n,
+            jumps: c.jumps as f64 / n,
         }
     }
 }
