@@ -21,12 +21,15 @@
 //!
 //! Grids are the cheapest structure to build and shine on evenly spread detail; they collapse
 //! when detail is concentrated (a teapot in a stadium puts the whole teapot into one or two
-//! cells), which the reports measure.
+//! cells), which the reports measure. Two variants attack that: the hierarchical grid
+//! ([`two_level`], `grid2`) refines crowded cells, and the skipping grid ([`skip`],
+//! `grid-skip`) lets rays jump over empty space with a distance field.
 #![forbid(unsafe_code)]
 
 pub mod build;
 mod dda;
 mod points;
+pub mod skip;
 mod traverse;
 pub mod two_level;
 mod validate;
@@ -37,6 +40,7 @@ use raybench_geom::{Aabb, Ray, Tri4, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
 
+pub use skip::{SkipGrid, SkipGridParams};
 pub use two_level::{Grid2, Grid2Params};
 
 /// The named knobs of a uniform grid, written into every report.
