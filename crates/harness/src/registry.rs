@@ -5,7 +5,7 @@ use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
 use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
-use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
+use raybench_grid::{Grid, Grid2, Grid2Params, GridParams, SkipGrid, SkipGridParams};
 use raybench_kdtree::{KdParams, KdTree};
 use raybench_octree::{Octree, OctreeParams};
 use std::sync::Arc;
@@ -195,6 +195,12 @@ pub fn registry() -> Vec<StructureEntry> {
             "uniform grid, λ = 8 cells per triangle (too many cells), exact insertion, 3D-DDA",
             None,
             |_| GridParams::fine(),
+        ),
+        register::<SkipGrid>(
+            "grid-skip",
+            "the λ = 1 uniform grid plus a distance field (per cell, the Chebyshev distance in cells to the nearest non-empty cell; Cohen–Sheffer proximity clouds): rays jump over the empty block around a cell 4 or more cells from a non-empty one, answers and triangle tests identical to grid's",
+            None,
+            |_| SkipGridParams::default(),
         ),
         register::<Grid2>(
             "grid2",

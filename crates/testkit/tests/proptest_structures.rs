@@ -23,7 +23,7 @@ use proptest::test_runner::FileFailurePersistence;
 use raybench_accel::classify::VerdictCounts;
 use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, WideParams};
 use raybench_geom::{Aabb, Ray, Triangle, TriangleMesh, Vec3};
-use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
+use raybench_grid::{Grid, Grid2, Grid2Params, GridParams, SkipGrid, SkipGridParams};
 use raybench_kdtree::{KdParams, KdTree};
 use raybench_octree::{Octree, OctreeParams};
 use raybench_testkit::{Case, check_case};
@@ -274,7 +274,7 @@ type Check = fn(&Case) -> Result<VerdictCounts, String>;
 
 /// Every structure with the parameters the registry builds it with
 /// (crates/harness/src/registry.rs), `validate()` after the build.
-const STRUCTURES: [(&str, Check); 14] = [
+const STRUCTURES: [(&str, Check); 16] = [
     ("bvh-median", |c| {
         check_case::<Bvh>(c, &BvhParams::median(), &|a, m| a.validate(m))
     }),
@@ -307,6 +307,17 @@ const STRUCTURES: [(&str, Check); 14] = [
     }),
     ("grid-fine", |c| {
         check_case::<Grid>(c, &GridParams::fine(), &|a, m| a.validate(m))
+    }),
+    ("grid-skip", |c| {
+        check_case::<SkipGrid>(c, &SkipGridParams::default(), &|a, m| a.validate(m))
+    }),
+    // Jumps from every cell that allows one, over a grid of mostly empty cells.
+    ("grid-skip-fine", |c| {
+        let params = SkipGridParams {
+            grid: GridParams::fine(),
+            min_jump: 2,
+        };
+        check_case::<SkipGrid>(c, &params, &|a, m| a.validate(m))
     }),
     ("grid2", |c| {
         check_case::<Grid2>(c, &Grid2Params::default(), &|a, m| a.validate(m))
