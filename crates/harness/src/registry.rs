@@ -210,7 +210,7 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<Octree>(
             "octree",
-            "octree, MAX_OBJ 8, MAX_DEPTH 20, exact insertion, front-to-back traversal with mailboxing",
+            "octree, MAX_OBJ 8, MAX_DEPTH from the scene (at least 20, down to its smallest triangles, at most 32), exact insertion sorted on both cores, front-to-back (parametric) traversal with mailboxing",
             None,
             |_| OctreeParams::default(),
         ),
