@@ -192,6 +192,37 @@ fn the_page_is_static_and_links_everything_it_shows() {
     }
 }
 
+#[test]
+fn the_page_opens_with_the_answer_per_scene_and_the_geometric_means() {
+    let html = std::fs::read_to_string(rendered().join("index.html")).unwrap();
+    let answer = html.find("id=\"answer\"").expect("an answer section");
+    let results = html.find("<h2>Results</h2>").expect("a results table");
+    assert!(answer < results, "the answer comes before the tables");
+    let section = &html[answer..html.find("id=\"summary\"").expect("a summary table")];
+    // One row per scene, each naming the fastest structure of each workload in bold.
+    for scene in [
+        "sphere:triangles=500",
+        "sphere:triangles=8000",
+        "plane:quads=8",
+    ] {
+        let row = section
+            .split("<tr>")
+            .find(|r| r.contains(&format!(">{scene}<")))
+            .unwrap_or_else(|| panic!("no answer row for {scene}"));
+        assert_eq!(row.matches("<b>").count(), 2, "{row}");
+        assert!(
+            ["bvh-binned", "embree-medium", "bruteforce"]
+                .iter()
+                .any(|s| row.contains(&format!("<b>{s}</b>"))),
+            "{row}"
+        );
+    }
+    // The geometric means: every structure but the reference, with its build ratio.
+    let summary = &html[html.find("id=\"summary\"").unwrap()..results];
+    assert!(summary.contains(">bvh-binned<") && summary.contains(">bruteforce<"));
+    assert!(!summary.contains(">embree-medium</td>"));
+}
+
 /// Debian's Chromium, if installed (scripts/test installs it).
 fn chromium() -> Option<PathBuf> {
     [

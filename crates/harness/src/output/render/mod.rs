@@ -13,6 +13,7 @@
 //!
 //! Every file is written atomically (a temporary file, then a rename).
 
+mod answer;
 mod break_even;
 pub mod charts;
 mod figures;

@@ -73,6 +73,7 @@ pub(crate) fn page(report: &Report, extras: &Extras) -> String {
     if let Some(sweep) = extras.sweep {
         sweep_note(&mut s, sweep);
     }
+    super::answer::answer_section(&mut s, report);
     results_table(&mut s, report);
     agreement_table(&mut s, report);
     if let Some(e) = extras.exponents {
