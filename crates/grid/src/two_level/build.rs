@@ -72,19 +72,20 @@ fn may_subdivide(level: u32, k: usize, params: &Grid2Params) -> bool {
 }
 
 /// The cells a triangle list falls into in `layout`, as (offsets, references): cell `c` holds
-/// `refs[offsets[c]..offsets[c + 1]]`, in the list's (ascending) order; `None` as soon as the
-/// references exceed `limit` (the grid would be refused: long triangles crossing many cells
-/// stop early instead of being inserted in full).
+/// `refs[offsets[c]..offsets[c + 1]]`, in the list's (ascending) order; `None` as soon as
+/// `keep` refuses the references so far (the test only grows stricter with more, so the grid
+/// would be refused anyway: long triangles crossing many cells stop early instead of being
+/// inserted in full).
 fn insert(
     mesh: &TriangleMesh,
     list: &[u32],
     layout: &Layout,
-    limit: usize,
+    keep: impl Fn(usize) -> bool,
 ) -> Option<(Vec<u32>, Vec<u32>)> {
     let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(list.len() * 2);
     for &id in list {
         layout.for_each_cell_clipped(&mesh.triangle(id as usize), |c| pairs.push((c as u32, id)));
-        if pairs.len() > limit {
+        if !keep(pairs.len()) {
             return None;
         }
     }
@@ -138,8 +139,10 @@ pub(super) fn own_grid(
     if !worth_it(list.len(), list.len(), &layout, params) {
         return None;
     }
-    let (offsets, refs) = insert(mesh, list, &layout, most_refs(list.len(), &layout, params))?;
-    worth_it(refs.len(), list.len(), &layout, params).then_some(Inserted {
+    // Checked after every triangle, so a grid that comes back passed with all its references.
+    let keep = |refs: usize| worth_it(refs, list.len(), &layout, params);
+    let (offsets, refs) = insert(mesh, list, &layout, keep)?;
+    Some(Inserted {
         layout,
         offsets,
         refs,
@@ -173,21 +176,6 @@ fn worth_it(refs: usize, k: usize, layout: &Layout, params: &Grid2Params) -> boo
     let per_cell = refs as f64 / layout.cells() as f64;
     let walk = params.entry_cost + steps * (params.cell_cost + per_cell);
     walk < k as f64
-}
-
-/// The most references a grid `layout` for `k` triangles may have and still pass [`worth_it`]
-/// (which only grows with them), saturating.
-fn most_refs(k: usize, layout: &Layout, params: &Grid2Params) -> usize {
-    let steps = layout.res.iter().sum::<u32>() as f64 / 2.0;
-    let per_cell = (k as f64 - params.entry_cost) / steps - params.cell_cost;
-    let most = (per_cell * layout.cells() as f64).ceil();
-    if most <= 0.0 {
-        0
-    } else if most < usize::MAX as f64 {
-        most as usize
-    } else {
-        usize::MAX
-    }
 }
 
 /// Counts `grid`'s references against the memory budget, then builds the grids of its
