@@ -7,8 +7,7 @@
 //! `cargo run --release -p raybench-harness --example grid2tune -- SCENE[,SCENE...] [top=1]
 //!  [cell=2] [levels=3] [crowded=8] [maxres=128] [enter=8] [step=4] [rays=100000] [reps=3]`
 
-use raybench_accel::{Accel, Counters};
-use raybench_geom::Ray;
+use raybench_accel::Accel;
 use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
 use std::sync::Arc;
 use std::time::Instant;
@@ -20,21 +19,9 @@ fn parse(v: &str) -> f64 {
     }
 }
 
-fn time<A: Accel>(a: &A, rays: &[Ray], reps: usize) -> (f64, Counters) {
-    let mut times = Vec::new();
-    for _ in 0..reps.max(3) {
-        let t = Instant::now();
-        let hits = rays.iter().filter(|r| a.intersect(r).is_some()).count();
-        std::hint::black_box(hits);
-        times.push(t.elapsed().as_secs_f64());
-    }
-    times.sort_by(f64::total_cmp);
-    let mut c = Counters::default();
-    for r in rays {
-        a.intersect_counted(r, &mut c);
-    }
-    (rays.len() as f64 / times[times.len() / 2] / 1e6, c)
-}
+mod probe;
+
+use probe::{scene_rays, time};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -56,10 +43,7 @@ fn main() {
         }
     }
     for spec in args[0].split(',') {
-        let scene = raybench_scenes::resolve(spec, 1).expect("scene");
-        let mesh = Arc::clone(&scene.mesh);
-        let random = raybench_scenes::random_rays(&mesh.bounds(), rays_n, 1);
-        let (primary, _, _) = raybench_scenes::primary_rays(&scene.view, &mesh.bounds(), rays_n);
+        let (mesh, random, primary) = scene_rays(spec, rays_n);
         let t = Instant::now();
         let g2 = Grid2::build(Arc::clone(&mesh), &p).expect("builds");
         let build2 = t.elapsed().as_secs_f64() * 1e3;

@@ -7,31 +7,14 @@
 //! `cargo run --release -p raybench-harness --example octtune -- SCENE[,SCENE...] [obj=8]
 //!  [depth=20] [ct=1] [rays=100000] [reps=3] [builds=5]`
 
-use raybench_accel::{Accel, Counters};
-use raybench_geom::Ray;
+use raybench_accel::Accel;
 use raybench_octree::{Octree, OctreeParams};
 use std::sync::Arc;
 use std::time::Instant;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+mod probe;
 
-fn time<A: Accel>(a: &A, rays: &[Ray], reps: usize) -> (f64, Counters) {
-    let mut times = Vec::new();
-    for _ in 0..reps.max(3) {
-        let t = Instant::now();
-        let hits = rays.iter().filter(|r| a.intersect(r).is_some()).count();
-        std::hint::black_box(hits);
-        times.push(t.elapsed().as_secs_f64());
-    }
-    let mut c = Counters::default();
-    for r in rays {
-        a.intersect_counted(r, &mut c);
-    }
-    (rays.len() as f64 / median(times) / 1e6, c)
-}
+use probe::{median, scene_rays, time};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -51,10 +34,7 @@ fn main() {
         }
     }
     for spec in args[0].split(',') {
-        let scene = raybench_scenes::resolve(spec, 1).expect("scene");
-        let mesh = Arc::clone(&scene.mesh);
-        let random = raybench_scenes::random_rays(&mesh.bounds(), rays_n, 1);
-        let (primary, _, _) = raybench_scenes::primary_rays(&scene.view, &mesh.bounds(), rays_n);
+        let (mesh, random, primary) = scene_rays(spec, rays_n);
         let mut bt = Vec::new();
         let mut oct = None;
         for _ in 0..builds.max(1) {

@@ -15,6 +15,10 @@ use raybench_grid::{Grid, GridParams, SkipGrid, SkipGridParams};
 use std::sync::Arc;
 use std::time::Instant;
 
+mod probe;
+
+use probe::scene_rays;
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (mut jumps, mut lambda, mut rays_n, mut rounds) = (vec![2u8, 3, 4], 1.0, 100_000, 8);
@@ -29,10 +33,7 @@ fn main() {
         }
     }
     for spec in args[0].split(',') {
-        let scene = raybench_scenes::resolve(spec, 1).expect("scene");
-        let mesh = Arc::clone(&scene.mesh);
-        let random = raybench_scenes::random_rays(&mesh.bounds(), rays_n, 1);
-        let (primary, _, _) = raybench_scenes::primary_rays(&scene.view, &mesh.bounds(), rays_n);
+        let (mesh, random, primary) = scene_rays(spec, rays_n);
         let grid_params = GridParams::with_density(lambda);
         let mut accels: Vec<(String, Box<dyn Accel>, f64)> = Vec::new();
         let t = Instant::now();

@@ -1,0 +1,44 @@
+//! What the knob probes (`grid2tune`, `octtune`, `skiptune`) share: a scene with its seeded
+//! random and primary rays, and a timed pass.
+
+use raybench_accel::{Accel, Counters};
+use raybench_geom::{Ray, TriangleMesh};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The scene `spec` (an .obj path or a generator spec, seed 1) with `n` seeded random rays and
+/// `n` primary rays from its view.
+#[allow(dead_code)]
+pub fn scene_rays(spec: &str, n: usize) -> (Arc<TriangleMesh>, Vec<Ray>, Vec<Ray>) {
+    let scene = raybench_scenes::resolve(spec, 1).expect("scene");
+    let mesh = Arc::clone(&scene.mesh);
+    let random = raybench_scenes::random_rays(&mesh.bounds(), n, 1);
+    let (primary, _, _) = raybench_scenes::primary_rays(&scene.view, &mesh.bounds(), n);
+    (mesh, random, primary)
+}
+
+/// The median of `v` (the upper one of an even count).
+#[allow(dead_code)]
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Mrays/s of `a` on `rays`, the median of `reps` timed passes (at least 3), and the counters
+/// of one counted pass.
+#[allow(dead_code)]
+pub fn time<A: Accel>(a: &A, rays: &[Ray], reps: usize) -> (f64, Counters) {
+    let times = (0..reps.max(3))
+        .map(|_| {
+            let t = Instant::now();
+            let hits = rays.iter().filter(|r| a.intersect(r).is_some()).count();
+            std::hint::black_box(hits);
+            t.elapsed().as_secs_f64()
+        })
+        .collect();
+    let mut c = Counters::default();
+    for r in rays {
+        a.intersect_counted(r, &mut c);
+    }
+    (rays.len() as f64 / median(times) / 1e6, c)
+}
