@@ -121,7 +121,8 @@ pub fn ratio_text(x: f64) -> String {
     }
 }
 
-fn cell(x: Option<f64>) -> String {
+/// A ratio cell: [`ratio_text`], or "-" when there is none.
+pub(crate) fn cell(x: Option<f64>) -> String {
     x.map_or("-".to_string(), ratio_text)
 }
 

@@ -6,7 +6,7 @@
 use super::names::{scene_names, workload_names};
 use super::page::escape;
 use super::ticks::tick_label;
-use crate::output::results::{headline_rows, ratio_text};
+use crate::output::results::{cell, headline_rows, ratio_text};
 use crate::report::run::Report;
 use std::fmt::Write;
 
@@ -141,7 +141,6 @@ fn summary_table(s: &mut String, report: &Report, workloads: &[String]) {
         let _ = write!(s, "<th>{}</th>", escape(w));
     }
     s.push_str("<th>build</th><th>memory</th><th>scenes</th></tr>\n");
-    let cell = |x: Option<f64>| x.map_or("–".to_string(), ratio_text);
     for r in rows {
         let _ = write!(s, "<tr><td class=\"l\">{}</td>", escape(&r.structure));
         for w in workloads {

@@ -25,6 +25,17 @@ pub struct Entry {
     pub swatch: Swatch,
 }
 
+/// Draws `entries` in the legend column of a chart panel of `panel_height` pixels whose side
+/// area starts at `(sx, sy)`: below the title, clear of the bottom axis labels.
+pub fn draw_beside(o: &mut Overlay, (sx, sy): (i32, i32), panel_height: u32, entries: &[Entry]) {
+    draw(
+        o,
+        (sx as f64 + 8.0, sy as f64 + 40.0),
+        panel_height as f64 - 60.0,
+        entries,
+    );
+}
+
 /// Draws `entries` top-down from `(x, y)` within `height` pixels: 16 pixels a row, closer when
 /// that does not fit, and the rest summed up in one "… and n more" row below 11 pixels a row.
 /// A label too long for the column is cut with "…" and keeps its full text as a hover title.

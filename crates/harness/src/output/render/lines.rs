@@ -228,12 +228,7 @@ fn draw<DB: DrawingBackend>(
             },
         }))
         .collect();
-    legend::draw(
-        o,
-        (sx as f64 + 8.0, sy as f64 + 40.0),
-        h as f64 - 60.0,
-        &entries,
-    );
+    legend::draw_beside(o, (sx, sy), h, &entries);
     Ok(())
 }
 
