@@ -99,6 +99,7 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
         results: Vec::new(),
         notes: Vec::new(),
         errors: Vec::new(),
+        claims: Vec::new(),
     };
 
     workers.pool.install(|| {

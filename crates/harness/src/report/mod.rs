@@ -3,6 +3,7 @@
 //! kinds share: the header every report opens with, the atomic JSON writer and the reader.
 
 pub mod agreement;
+pub mod claims;
 pub mod compare;
 pub mod run;
 pub mod verify;

@@ -30,6 +30,9 @@ pub struct Report {
     pub notes: Vec<String>,
     /// Scenes or structures that failed (the rest of the run went on).
     pub errors: Vec<String>,
+    /// The claims this run's data decides (see [`super::claims`]); empty in older reports.
+    #[serde(default)]
+    pub claims: Vec<super::claims::Claim>,
 }
 
 /// The knobs of the run itself.

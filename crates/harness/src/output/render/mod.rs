@@ -15,6 +15,7 @@
 
 mod answer;
 mod break_even;
+mod claims_section;
 pub mod charts;
 mod figures;
 pub mod fit;
@@ -23,6 +24,8 @@ pub mod lines;
 pub mod names;
 mod overlay;
 mod page;
+mod picture_files;
+mod picture_section;
 pub mod palette;
 pub mod pictures;
 mod scaling;
@@ -31,10 +34,9 @@ mod sweep_charts;
 pub mod ticks;
 
 use crate::atomic::write_atomic;
-use crate::report::run::{Report, ResultEntry};
+use crate::report::run::Report;
 use anyhow::{Context, Result};
 use figures::all_charts;
-use names::{scene_names, scene_slugs, slug};
 use scaling::{Exponents, Sizes};
 use std::path::{Path, PathBuf};
 use sweep::Sweep;
@@ -85,7 +87,7 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
             caption,
         });
     }
-    let pictures = write_pictures(report, dir, &mut out.images)?;
+    let pictures = picture_files::write_pictures(report, dir, &mut out.images)?;
     let exponents = Sizes::of(report, sweep.as_ref()).map(|sizes| Exponents::of(report, &sizes));
     let page = page::page(
         report,
@@ -98,65 +100,5 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
     );
     out.index = dir.join("index.html");
     write_atomic(&out.index, page.as_bytes())?;
-    Ok(out)
-}
-
-fn write_pictures(
-    report: &Report,
-    dir: &Path,
-    written: &mut Vec<PathBuf>,
-) -> Result<Vec<ScenePictures>> {
-    let legend = dir.join("images").join("legend-viridis.png");
-    pictures::write_legend(&legend)?;
-    written.push(legend);
-    let mut out = Vec::new();
-    let slugs = scene_slugs(report);
-    for scene in scene_names(report) {
-        let entries: Vec<&ResultEntry> = report
-            .results
-            .iter()
-            .filter(|r| r.scene == scene && r.primary_image.is_some())
-            .collect();
-        if entries.is_empty() {
-            continue;
-        }
-        let images: Vec<_> = entries
-            .iter()
-            .filter_map(|r| r.primary_image.as_ref())
-            .collect();
-        let max = pictures::shared_max(&images);
-        let mut rows = Vec::new();
-        for r in &entries {
-            let img = r.primary_image.as_ref().expect("filtered");
-            let base = format!("{}--{}", slugs[&scene], slug(&r.structure));
-            let file = |kind: &str| format!("images/{base}-{kind}.png");
-            let row = (|| -> Result<_> {
-                let heat = match pictures::heatmap_pixels(img, max)? {
-                    Some(px) => {
-                        let f = file("cost");
-                        pictures::write(&px, img, &dir.join(&f))?;
-                        written.push(dir.join(&f));
-                        Some(f)
-                    }
-                    None => None,
-                };
-                let render = file("render");
-                pictures::write(&pictures::shade_pixels(img)?, img, &dir.join(&render))?;
-                let mask = file("disagree");
-                pictures::write(&pictures::disagree_pixels(img)?, img, &dir.join(&mask))?;
-                written.push(dir.join(&render));
-                written.push(dir.join(&mask));
-                Ok((r.structure.clone(), heat, render, mask))
-            })()
-            .with_context(|| format!("the pictures of {scene} / {}", r.structure))?;
-            rows.push(row);
-        }
-        out.push(ScenePictures {
-            scene,
-            max_cost: max,
-            downsample: images[0].downsample,
-            rows,
-        });
-    }
     Ok(out)
 }

@@ -74,6 +74,7 @@ pub(crate) fn page(report: &Report, extras: &Extras) -> String {
         sweep_note(&mut s, sweep);
     }
     super::answer::answer_section(&mut s, report);
+    super::claims_section::claims_section(&mut s, report);
     results_table(&mut s, report);
     agreement_table(&mut s, report);
     if let Some(e) = extras.exponents {
@@ -89,7 +90,7 @@ pub(crate) fn page(report: &Report, extras: &Extras) -> String {
             escape(&c.caption)
         );
     }
-    pictures_section(&mut s, extras.pictures);
+    super::picture_section::pictures_section(&mut s, extras.pictures);
     notes(&mut s, report);
     environment(&mut s, report);
     s.push_str("</body></html>\n");
@@ -259,45 +260,6 @@ fn agreement_table(s: &mut String, report: &Report) {
         );
     }
     s.push_str("</table>\n");
-}
-
-fn pictures_section(s: &mut String, pictures: &[ScenePictures]) {
-    if pictures.is_empty() {
-        return;
-    }
-    s.push_str(
-        "<h2>Primary rays, per pixel</h2>\n<p class=\"note\">Traversal cost is interior nodes + \
-         leaves + triangle tests + cells per pixel, on one logarithmic colour scale per scene (legend below each \
-         scene). The mask shows where the structure disagrees with the reference: amber for an \
-         explained difference (tie, boundary, edge-ambiguous), red for a mismatch.</p>\n",
-    );
-    for p in pictures {
-        let _ = writeln!(
-            s,
-            "<h3>{}</h3>\n<p class=\"note\">cost scale (logarithmic): 0 <img src=\"images/legend-viridis.png\" \
-             alt=\"colour scale\" style=\"vertical-align:middle;width:256px;height:14px\"> {} \
-             (downsampled {}×{} pixels per stored pixel)</p>",
-            escape(&p.scene),
-            p.max_cost,
-            p.downsample,
-            p.downsample
-        );
-        s.push_str("<table><tr><th class=\"l\">structure</th><th>traversal cost</th><th>render</th><th>disagrees with the reference</th></tr>\n");
-        for (st, heat, render, mask) in &p.rows {
-            let heat = heat.as_ref().map_or("not counted".to_string(), |f| {
-                format!("<img class=\"px\" src=\"{}\" alt=\"cost\">", escape(f))
-            });
-            let _ = writeln!(
-                s,
-                "<tr><td class=\"l\">{}</td><td>{heat}</td><td><img class=\"px\" src=\"{}\" alt=\"render\"></td>\
-                 <td><img class=\"px\" src=\"{}\" alt=\"mask\"></td></tr>",
-                escape(st),
-                escape(render),
-                escape(mask)
-            );
-        }
-        s.push_str("</table>\n");
-    }
 }
 
 fn notes(s: &mut String, report: &Report) {
