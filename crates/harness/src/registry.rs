@@ -173,6 +173,12 @@ pub fn registry() -> Vec<StructureEntry> {
             |_| KdParams::packets(),
         ),
         register::<KdTree>(
+            "kd-sah-exhaustive",
+            "the kd-sah tree walked to the end of every ray's segment, no early exit at the first hit (what stopping saves; same answers)",
+            None,
+            |_| KdParams::exhaustive(),
+        ),
+        register::<KdTree>(
             "kd-median",
             "k-d tree, spatial median with round-robin axes (the baseline), early exit, mailbox",
             None,

@@ -6,7 +6,7 @@
 //! 8-byte nodes plus one reference array ([`build`], [`Node`]), traversed from that flat form
 //! with a small on-stack mailbox (`traverse.rs` has the details). Closest-point queries walk
 //! the same tree nearest child first, pruned by the distance to each cell (`points.rs`); the
-//! zero-area triangles rays never hit live in a side tree only they walk. Two registered
+//! zero-area triangles rays never hit live in a side tree only they walk. The registered
 //! variants share the code:
 //!
 //! | name | builder | reference |
@@ -14,6 +14,7 @@
 //! | `kd-sah` | SAH with perfect splits, event sweep, O(N log N) | Wald and Havran 2006 |
 //! | `kd-median` | spatial median, round-robin axes | the textbook baseline |
 //! | `kd-packets` | `kd-sah`, coherent batches walked sixteen rays at a time (`packets.rs`) | Wald 2004 |
+//! | `kd-sah-exhaustive` | `kd-sah`, walked without early exit: what stopping at the first hit saves | — |
 #![deny(unsafe_code)] // allowed only in the AVX-512 packet walk, `packets.rs`
 
 pub mod build;
@@ -72,6 +73,10 @@ pub struct KdParams {
     /// Record tested triangles in a small per-ray table so a triangle referenced by several
     /// leaves is tested once (skips are counted as `mailbox_skips`).
     pub mailbox: bool,
+    /// Stop a closest-hit walk once no pending cell can hold a nearer hit (the k-d tree's
+    /// early termination). Off only in `kd-sah-exhaustive`, which walks every cell the ray's
+    /// segment crosses, to measure what stopping saves; answers are the same either way.
+    pub early_exit: bool,
     /// Nodes with more triangles than this build their two subtrees on two rayon tasks (near
     /// the root only: a handful of tasks per worker thread).
     pub parallel_threshold: u32,
@@ -112,6 +117,7 @@ impl KdParams {
             leaf_size: 0,
             packets: false,
             mailbox: true,
+            early_exit: true,
             parallel_threshold: 16_384,
             memory_limit_bytes: KdParams::MEMORY_LIMIT,
         }
@@ -136,6 +142,14 @@ impl KdParams {
         }
     }
 
+    /// `kd-sah-exhaustive`: the `kd-sah` tree walked without early termination.
+    pub fn exhaustive() -> KdParams {
+        KdParams {
+            early_exit: false,
+            ..KdParams::sah()
+        }
+    }
+
     /// The registered name of this configuration.
     pub fn name(&self) -> String {
         let base = match (self.builder, self.packets) {
@@ -144,8 +158,13 @@ impl KdParams {
             (Builder::Median, true) => "kd-median-packets",
             (Builder::Median, false) => "kd-median",
         };
-        if self.mailbox {
+        let base = if self.early_exit {
             base.to_string()
+        } else {
+            format!("{base}-exhaustive")
+        };
+        if self.mailbox {
+            base
         } else {
             format!("{base}-nomailbox")
         }
@@ -347,10 +366,11 @@ impl KdTree {
 
 impl Walk for KdTree {
     fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
-        if self.params.mailbox {
-            self.trace::<ANY_HIT, true, C>(ray, c)
-        } else {
-            self.trace::<ANY_HIT, false, C>(ray, c)
+        match (self.params.mailbox, self.params.early_exit) {
+            (true, true) => self.trace::<ANY_HIT, true, true, C>(ray, c),
+            (false, true) => self.trace::<ANY_HIT, false, true, C>(ray, c),
+            (true, false) => self.trace::<ANY_HIT, true, false, C>(ray, c),
+            (false, false) => self.trace::<ANY_HIT, false, false, C>(ray, c),
         }
     }
 

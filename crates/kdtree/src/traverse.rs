@@ -59,19 +59,33 @@ impl KdTree {
     /// about 300k triangles) gets a 32-entry stack, so each ray initialises 384 bytes of stack
     /// instead of 768.
     #[inline(always)]
-    pub(crate) fn trace<const ANY_HIT: bool, const MAILBOX: bool, C: CounterSink>(
+    pub(crate) fn trace<
+        const ANY_HIT: bool,
+        const MAILBOX: bool,
+        const EARLY_EXIT: bool,
+        C: CounterSink,
+    >(
         &self,
         ray: &Ray,
         c: &mut C,
     ) -> Option<Hit> {
         if self.depth_limit as usize <= SMALL_STACK {
-            self.walk::<ANY_HIT, MAILBOX, SMALL_STACK, C>(ray, c)
+            self.walk::<ANY_HIT, MAILBOX, EARLY_EXIT, SMALL_STACK, C>(ray, c)
         } else {
-            self.walk::<ANY_HIT, MAILBOX, MAX_DEPTH, C>(ray, c)
+            self.walk::<ANY_HIT, MAILBOX, EARLY_EXIT, MAX_DEPTH, C>(ray, c)
         }
     }
 
-    fn walk<const ANY_HIT: bool, const MAILBOX: bool, const STACK: usize, C: CounterSink>(
+    /// `EARLY_EXIT = false` keeps walking every pending cell after a hit (each triangle still
+    /// tested against the closest hit so far, so the answer is the same): the walk without
+    /// early termination, measured to show what stopping saves. Any hit always stops.
+    fn walk<
+        const ANY_HIT: bool,
+        const MAILBOX: bool,
+        const EARLY_EXIT: bool,
+        const STACK: usize,
+        C: CounterSink,
+    >(
         &self,
         ray: &Ray,
         c: &mut C,
@@ -155,12 +169,16 @@ impl KdTree {
                 }
                 sp -= 1;
                 let (next, enter, exit) = stack[sp];
-                if !ANY_HIT && enter > best_t {
+                if !ANY_HIT && EARLY_EXIT && enter > best_t {
                     continue;
                 }
                 at = next;
                 t0 = enter;
-                t1 = if ANY_HIT { exit } else { exit.min(best_t) };
+                t1 = if ANY_HIT || !EARLY_EXIT {
+                    exit
+                } else {
+                    exit.min(best_t)
+                };
                 break;
             }
         }

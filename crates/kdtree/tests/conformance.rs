@@ -29,6 +29,15 @@ fn without_mailbox_conforms() {
 }
 
 #[test]
+fn exhaustive_walk_conforms() {
+    check(KdParams::exhaustive());
+    check(KdParams {
+        mailbox: false,
+        ..KdParams::exhaustive()
+    });
+}
+
+#[test]
 fn extreme_knobs_conform() {
     // A single leaf holding everything (depth 0).
     check(KdParams {

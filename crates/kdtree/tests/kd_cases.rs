@@ -255,6 +255,8 @@ fn counters_show_early_exit_and_mailbox_skips() {
         },
     )
     .unwrap();
+    let exhaustive = KdTree::build(mesh.clone(), &KdParams::exhaustive()).unwrap();
+    assert_eq!(exhaustive.validate(&mesh), Ok(()));
     let bf = BruteForce::build(mesh.clone(), &Default::default()).unwrap();
     // Rays through the centre from outside: the first leaf hit ends the walk, far before the
     // back of the sphere.
@@ -263,12 +265,21 @@ fn counters_show_early_exit_and_mailbox_skips() {
             .into_iter()
             .map(|r| Ray::infinite(r.origin() - r.dir() * 3.0, r.dir()))
             .collect();
-    let (mut c, mut c_no) = (Counters::default(), Counters::default());
+    let (mut c, mut c_no, mut c_all) = (
+        Counters::default(),
+        Counters::default(),
+        Counters::default(),
+    );
     for r in &rays {
         let h = kd.intersect_counted(r, &mut c);
         assert_eq!(h.map(|h| h.prim), bf.intersect(r).map(|h| h.prim));
         no_mb.intersect_counted(r, &mut c_no);
+        assert_eq!(exhaustive.intersect_counted(r, &mut c_all), h, "same answer");
     }
+    // Without early exit the walk goes on through the back of the sphere: at least twice the
+    // leaves (front and back surfaces), every one of which early exit skipped.
+    assert!(c_all.leaves >= 2 * c.leaves, "{c_all:?} vs {c:?}");
+    assert!(c_all.prim_tests > c.prim_tests, "{c_all:?} vs {c:?}");
     let n = rays.len() as u64;
     let leaves_total = kd.build_stats().leaves;
     assert!(c.leaves < 30 * n, "early exit: {c:?}");
