@@ -81,6 +81,7 @@ pub fn summary_table(report: &Report) -> String {
     }
     write_point_work(&mut out, report);
     write_agreement(&mut out, report);
+    write_claims(&mut out, report);
     for n in &report.notes {
         let _ = writeln!(out, "note: {n}");
     }
@@ -216,5 +217,25 @@ mod tests {
         assert_eq!(super::sig(24.863), "24.9");
         assert_eq!(super::sig(1.0), "1.00");
         assert_eq!(super::sig(1234.5), "1234");
+    }
+}
+
+/// The claims' verdicts, one line each; one line in all when the run measured none of them.
+fn write_claims(out: &mut String, report: &Report) {
+    use crate::report::claims::Verdict;
+    let claims = &report.claims;
+    if claims.iter().all(|c| c.verdict == Verdict::NotMeasured) {
+        if !claims.is_empty() {
+            let _ = writeln!(
+                out,
+                "claims: none measured in this run (`raybench run --suite claims` measures all {})",
+                claims.len()
+            );
+        }
+        return;
+    }
+    let _ = writeln!(out, "claims (rules and figures on the page and in report.json):");
+    for c in claims {
+        let _ = writeln!(out, "  {:<24} {:<24} {}", c.id, c.verdict.text(), c.statement);
     }
 }

@@ -140,6 +140,10 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
         dump.finish()?;
     }
     fill_ratios(&mut report);
+    report.claims = crate::report::claims::evaluate(&report)
+        .into_iter()
+        .map(|e| e.claim)
+        .collect();
     Ok(report)
 }
 

@@ -15,8 +15,8 @@
 
 mod answer;
 mod break_even;
-mod claims_section;
 pub mod charts;
+mod claims_section;
 mod figures;
 pub mod fit;
 mod legend;
@@ -24,9 +24,9 @@ pub mod lines;
 pub mod names;
 mod overlay;
 mod page;
+pub mod palette;
 mod picture_files;
 mod picture_section;
-pub mod palette;
 pub mod pictures;
 mod scaling;
 pub mod sweep;
@@ -87,6 +87,13 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
             caption,
         });
     }
+    let mut claim_charts = Vec::new();
+    for (file, svg) in claims_section::claim_charts(report)? {
+        let path = dir.join(&file);
+        write_atomic(&path, svg.as_bytes())?;
+        out.charts.push(path);
+        claim_charts.push(file);
+    }
     let pictures = picture_files::write_pictures(report, dir, &mut out.images)?;
     let exponents = Sizes::of(report, sweep.as_ref()).map(|sizes| Exponents::of(report, &sizes));
     let page = page::page(
@@ -96,6 +103,7 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
             pictures: &pictures,
             sweep: sweep.as_ref(),
             exponents: exponents.as_ref(),
+            claim_charts: &claim_charts,
         },
     );
     out.index = dir.join("index.html");

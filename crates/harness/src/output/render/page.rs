@@ -24,7 +24,7 @@ th{background:#f0f0f0}td.l,th.l{text-align:left}\
 figure{margin:18px 0}figcaption{font-size:13px;color:#444}\
 img.chart{max-width:100%;border:1px solid #ddd}\
 img.px{image-rendering:pixelated;width:240px;border:1px solid #ddd}\
-.bad{color:#c00;font-weight:bold}.note{color:#555;font-size:13px}";
+.bad{color:#c00;font-weight:bold}.holds{color:#080;font-weight:bold}.note{color:#555;font-size:13px}";
 
 /// What the page shows beside the report itself.
 pub(crate) struct Extras<'a> {
@@ -34,6 +34,8 @@ pub(crate) struct Extras<'a> {
     pub sweep: Option<&'a Sweep>,
     /// Fitted exponents against N, when the scenes grow.
     pub exponents: Option<&'a Exponents>,
+    /// The claim charts written (see [`super::claims_section`]).
+    pub claim_charts: &'a [String],
 }
 
 pub(crate) fn page(report: &Report, extras: &Extras) -> String {
@@ -74,7 +76,7 @@ pub(crate) fn page(report: &Report, extras: &Extras) -> String {
         sweep_note(&mut s, sweep);
     }
     super::answer::answer_section(&mut s, report);
-    super::claims_section::claims_section(&mut s, report);
+    super::claims_section::claims_section(&mut s, report, extras.claim_charts);
     results_table(&mut s, report);
     agreement_table(&mut s, report);
     if let Some(e) = extras.exponents {
