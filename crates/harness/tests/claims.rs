@@ -233,7 +233,7 @@ fn breaking_a_law_breaks_exactly_its_claim() {
         }),
         ("kd-early-exit", |st, _, _, m| match st {
             "kd-sah-exhaustive" => M {
-                leaves: m.leaves / 3.0 * 1.5,
+                leaves: m.leaves / 3.0 * 1.1,
                 ..m
             },
             _ => m,

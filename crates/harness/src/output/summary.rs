@@ -234,8 +234,17 @@ fn write_claims(out: &mut String, report: &Report) {
         }
         return;
     }
-    let _ = writeln!(out, "claims (rules and figures on the page and in report.json):");
+    let _ = writeln!(
+        out,
+        "claims (rules and figures on the page and in report.json):"
+    );
     for c in claims {
-        let _ = writeln!(out, "  {:<24} {:<24} {}", c.id, c.verdict.text(), c.statement);
+        let _ = writeln!(
+            out,
+            "  {:<24} {:<24} {}",
+            c.id,
+            c.verdict.text(),
+            c.statement
+        );
     }
 }
