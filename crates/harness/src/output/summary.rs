@@ -209,17 +209,6 @@ fn truncate(s: &str, n: usize) -> String {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn three_significant_digits() {
-        assert_eq!(super::sig(0.001234), "0.00123");
-        assert_eq!(super::sig(24.863), "24.9");
-        assert_eq!(super::sig(1.0), "1.00");
-        assert_eq!(super::sig(1234.5), "1234");
-    }
-}
-
 /// The claims' verdicts, one line each; one line in all when the run measured none of them.
 fn write_claims(out: &mut String, report: &Report) {
     use crate::report::claims::Verdict;
@@ -246,5 +235,16 @@ fn write_claims(out: &mut String, report: &Report) {
             c.verdict.text(),
             c.statement
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn three_significant_digits() {
+        assert_eq!(super::sig(0.001234), "0.00123");
+        assert_eq!(super::sig(24.863), "24.9");
+        assert_eq!(super::sig(1.0), "1.00");
+        assert_eq!(super::sig(1234.5), "1234");
     }
 }
