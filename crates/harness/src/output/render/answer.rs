@@ -91,6 +91,28 @@ pub(crate) fn answer_section(
     answer_table(s, report, &scene_names(report), link);
 }
 
+/// Under a scene's name: its triangles, and its mismatches when there are any.
+fn scene_facts(report: &Report, scene: &str) -> String {
+    let results: Vec<_> = report.results.iter().filter(|r| r.scene == scene).collect();
+    let Some(first) = results.first() else {
+        return String::new();
+    };
+    let bad: u64 = results
+        .iter()
+        .flat_map(|r| &r.workloads)
+        .map(|w| w.agreement.counts.mismatch + w.agreement.counted_path_differs)
+        .sum();
+    let mut out = format!(
+        "<br><small>{} triangles",
+        tick_label(first.triangles.traced as f64)
+    );
+    if bad > 0 {
+        let _ = write!(out, "; <span class=\"bad\">{bad} mismatches</span>");
+    }
+    out.push_str("</small>");
+    out
+}
+
 /// The answer rows of `scenes`; a scene whose `link` is known is a link.
 pub(crate) fn answer_table(
     s: &mut String,
@@ -105,19 +127,15 @@ pub(crate) fn answer_table(
     }
     s.push_str("</tr>\n");
     for scene in scenes {
-        match link(scene) {
-            Some(file) => {
-                let _ = write!(
-                    s,
-                    "<tr><td class=\"l\"><a href=\"{}\">{}</a></td>",
-                    escape(&file),
-                    escape(scene)
-                );
-            }
-            None => {
-                let _ = write!(s, "<tr><td class=\"l\">{}</td>", escape(scene));
-            }
-        }
+        let name = match link(scene) {
+            Some(file) => format!("<a href=\"{}\">{}</a>", escape(&file), escape(scene)),
+            None => escape(scene),
+        };
+        let _ = write!(
+            s,
+            "<tr><td class=\"l\">{name}{}</td>",
+            scene_facts(report, scene)
+        );
         for w in &workloads {
             match answer(report, scene, w) {
                 None => s.push_str("<td class=\"l\">–</td>"),

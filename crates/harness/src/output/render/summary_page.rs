@@ -1,9 +1,10 @@
 //! `index.html`, the summary: the run, the mismatch count, the answer per scene and workload,
 //! each structure's geometric means with their spread, the claims, a sweep's exponents, and
-//! where everything else is. It stays a few screens tall whatever the suite: every per-scene
-//! figure lives on the scene's own page, every chart on the charts page.
+//! where everything else is. It grows by one answer row per scene and nothing else, so it
+//! stays a few screens tall for suites of a few dozen scenes: every per-scene figure lives on
+//! the scene's own page, every chart on the charts page.
 
-use super::page::{CHARTS_FILE, Current, DETAILS_FILE, Site, escape};
+use super::page::{CHARTS_FILE, Current, DETAILS_FILE, Site};
 use super::tables::{exponents_table, sweep_note};
 use std::fmt::Write as _;
 
@@ -78,46 +79,12 @@ fn more(s: &mut String, site: &Site) {
     let cross_scene = site.charts.iter().filter(|c| c.scene.is_none()).count();
     let _ = writeln!(
         s,
-        "<h2 id=\"more\">Scenes, charts and details</h2>\n<ul>\n<li>Each scene's page: its \
-         rows of the results, its break-even chart and its pictures.</li>\n<li><a \
-         href=\"{CHARTS_FILE}\">Charts</a>: {cross_scene} chart(s) across the scenes (build \
-         time, throughput, ratios, memory, work per query, agreement).</li>\n<li><a \
-         href=\"{DETAILS_FILE}\">All results, agreement, environment</a>: every scene × \
-         structure, the validation classes, notes and errors, the machine and the \
-         settings.</li>\n</ul>"
+        "<h2 id=\"more\">Scenes, charts and details</h2>\n<ul>\n<li>Each scene's page (its \
+         name in the answer table and at the top lead to it): its rows of the results, its \
+         break-even chart and its pictures.</li>\n<li><a href=\"{CHARTS_FILE}\">Charts</a>: \
+         {cross_scene} chart(s) across the scenes (build time, throughput, ratios, memory, work \
+         per query, agreement).</li>\n<li><a href=\"{DETAILS_FILE}\">All results, agreement, \
+         environment</a>: every scene × structure, the validation classes, notes and errors, \
+         the machine and the settings.</li>\n</ul>"
     );
-    s.push_str(
-        "<table class=\"sortable scenes\"><thead><tr><th class=\"l\">scene</th>\
-                <th>triangles</th><th>structures</th><th>mismatches</th></tr></thead>\n<tbody>\n",
-    );
-    for (scene, file) in &site.scenes {
-        let results: Vec<_> = site
-            .report
-            .results
-            .iter()
-            .filter(|r| &r.scene == scene)
-            .collect();
-        let triangles = site
-            .report
-            .scenes
-            .iter()
-            .find(|r| &r.name == scene)
-            .map(|r| r.triangles.traced)
-            .or_else(|| results.first().map(|r| r.triangles.traced));
-        let bad: u64 = results
-            .iter()
-            .flat_map(|r| &r.workloads)
-            .map(|w| w.agreement.counts.mismatch + w.agreement.counted_path_differs)
-            .sum();
-        let _ = writeln!(
-            s,
-            "<tr><td class=\"l\"><a href=\"{}\">{}</a></td><td>{}</td><td>{}</td><td{}>{bad}</td></tr>",
-            escape(file),
-            escape(scene),
-            triangles.map_or("-".into(), |t| t.to_string()),
-            results.len(),
-            if bad > 0 { " class=\"bad\"" } else { "" }
-        );
-    }
-    s.push_str("</tbody></table>\n");
 }
