@@ -4,7 +4,7 @@
 
 use super::environment::environment;
 use super::names::scene_names;
-use super::page::{Current, Site, figure};
+use super::page::{Current, Site, escape, figure, figure_id};
 use super::tables::{agreement_table, exponents_table, notes, results_table};
 use std::fmt::Write as _;
 
@@ -21,6 +21,22 @@ pub(crate) fn charts_page(site: &Site) -> String {
     );
     if charts.is_empty() {
         s.push_str("<p>The report has no figure to chart.</p>\n");
+    } else {
+        // Twenty-odd charts are many screens: a list of them first, each a link to its figure.
+        s.push_str("<p class=\"toc\">On this page: ");
+        for (i, c) in charts.iter().enumerate() {
+            if i > 0 {
+                s.push_str(" · ");
+            }
+            let _ = write!(
+                s,
+                "<a href=\"#{}\" title=\"{}\">{}</a>",
+                escape(&figure_id(c)),
+                escape(&c.caption),
+                escape(short(&c.caption))
+            );
+        }
+        s.push_str("</p>\n");
     }
     for c in charts {
         figure(&mut s, c);
@@ -67,4 +83,15 @@ pub(crate) fn details_page(site: &Site) -> String {
     environment(&mut s, report);
     site.close(&mut s);
     s
+}
+
+/// A caption's first clause, for the list of charts: "Throughput on `primary` (median …"
+/// → "Throughput on `primary`".
+fn short(caption: &str) -> &str {
+    let end = [" (", ", ", ": ", " in the same run"]
+        .iter()
+        .filter_map(|p| caption.find(p))
+        .min()
+        .unwrap_or(caption.len());
+    caption[..end].trim()
 }

@@ -206,13 +206,21 @@ pub(crate) fn scene_file(slug: &str) -> String {
     format!("scene-{slug}.html")
 }
 
-/// A figure of one chart, as every page shows it.
+/// A figure of one chart, as every page shows it, with the chart's file stem as its id.
 pub(crate) fn figure(s: &mut String, c: &ChartFile) {
     let _ = writeln!(
         s,
-        "<figure><img class=\"chart\" src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
+        "<figure id=\"{}\"><img class=\"chart\" src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption>\
+         </figure>",
+        escape(&figure_id(c)),
         escape(&c.file),
         escape(&c.caption),
         escape(&c.caption)
     );
+}
+
+/// `charts/build-ms.svg` → `build-ms`.
+pub(crate) fn figure_id(c: &ChartFile) -> String {
+    let name = c.file.rsplit('/').next().unwrap_or(&c.file);
+    name.strip_suffix(".svg").unwrap_or(name).to_string()
 }

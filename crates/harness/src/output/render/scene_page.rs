@@ -21,6 +21,24 @@ pub(crate) fn scene_page(site: &Site, scene: &str) -> String {
     if let Some(record) = report.scenes.iter().find(|r| r.name == scene) {
         facts(&mut s, record);
     }
+    let notes: Vec<&String> = report
+        .errors
+        .iter()
+        .chain(&report.notes)
+        .filter(|n| mentions(n, scene))
+        .collect();
+    if !notes.is_empty() {
+        s.push_str("<ul>\n");
+        for n in notes {
+            let class = if report.errors.contains(n) {
+                "bad"
+            } else {
+                "note"
+            };
+            let _ = writeln!(s, "<li class=\"{class}\">{}</li>", escape(n));
+        }
+        s.push_str("</ul>\n");
+    }
     let scenes = [scene.to_string()];
     s.push_str("<h2 id=\"answer\">The answer</h2>\n");
     super::answer::answer_table(&mut s, report, &scenes, &|_| None);
@@ -98,4 +116,32 @@ fn params(p: Option<&serde_json::Value>) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// Whether `note` names `scene` as a whole (`teapot` is not named by "… on teapot-in-stadium"
+/// nor `teapot-in-stadium` by "… on teapot-in-stadium:view=stadium").
+fn mentions(note: &str, scene: &str) -> bool {
+    note.match_indices(scene).any(|(i, _)| {
+        let before = note[..i].chars().next_back();
+        let after = note[i + scene.len()..].chars().next();
+        matches!(before, None | Some(' ' | '(' | '\'' | '`'))
+            && matches!(after, None | Some(' ' | ')' | ',' | ';' | '\'' | '`'))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::mentions;
+
+    #[test]
+    fn a_note_names_a_scene_only_as_a_whole() {
+        let note = "bruteforce skipped on teapot-in-stadium (219956 triangles > 20000)";
+        assert!(mentions(note, "teapot-in-stadium"));
+        assert!(!mentions(note, "teapot"));
+        assert!(!mentions(
+            "x on teapot-in-stadium:view=stadium",
+            "teapot-in-stadium"
+        ));
+        assert!(mentions("scene `teapot.obj` not found", "teapot.obj"));
+    }
 }
