@@ -414,7 +414,10 @@ fn the_agreement_chart_draws_every_class() {
         "mismatch",
     ] {
         // plotters writes a caption's text on a line of its own.
-        assert!(svg.contains(&format!("\n{class}: ")), "no panel for {class}");
+        assert!(
+            svg.contains(&format!("\n{class}: ")),
+            "no panel for {class}"
+        );
     }
     let with_bars = [
         "both miss",
