@@ -359,7 +359,7 @@ fn every_scene_has_a_page_with_its_rows_chart_and_pictures() {
         for r in &results {
             let row = rows
                 .iter()
-                .find(|row| row.starts_with(&format!("<td class=\"l\">{}</td>", r.structure)))
+                .find(|row| row.starts_with(&format!("<td class=\"l st\">{}</td>", r.structure)))
                 .unwrap_or_else(|| panic!("{file} has no row for {}", r.structure));
             assert!(
                 row.contains(&format!("<td>{}</td>", r.triangles.traced)),

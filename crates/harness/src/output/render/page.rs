@@ -26,7 +26,7 @@ th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}\
 th{background:#f0f0f0}td.l,th.l{text-align:left}\
 table.sortable th{cursor:pointer}th[aria-sort=ascending]::after{content:\" ▲\"}\
 th[aria-sort=descending]::after{content:\" ▼\"}\
-td small{color:#555}table.geomeans small{white-space:nowrap}\
+td small{color:#555}table.geomeans small,td.st{white-space:nowrap}\
 figure{margin:18px 0}figcaption{font-size:13px;color:#444}\
 img.chart{max-width:100%;border:1px solid #ddd}\
 img.px{image-rendering:pixelated;width:240px;border:1px solid #ddd}\

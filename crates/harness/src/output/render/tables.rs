@@ -50,8 +50,8 @@ pub(crate) fn results_table(s: &mut String, report: &Report, scenes: &[String]) 
             }
             let _ = write!(
                 s,
-                "<td class=\"l\">{}</td><td>{}</td><td title=\"fastest {:.1}, slowest {:.1} of {} \
-                 runs\">{:.1} ({})</td><td>{:.1}</td><td>{}</td>",
+                "<td class=\"l st\">{}</td><td>{}</td><td title=\"fastest {:.1}, slowest {:.1} of {} \
+                 runs\">{:.1} <small>({})</small></td><td>{:.1}</td><td>{}</td>",
                 escape(&st),
                 r.triangles.traced,
                 r.build.min_ms,
@@ -70,7 +70,7 @@ pub(crate) fn results_table(s: &mut String, report: &Report, scenes: &[String]) 
                         let t = &x.mqueries_per_s;
                         let _ = write!(
                             s,
-                            "<td title=\"slowest {:.2}, fastest {:.2} of {} runs\">{:.2} ({})</td>",
+                            "<td title=\"slowest {:.2}, fastest {:.2} of {} runs\">{:.2} <small>({})</small></td>",
                             t.min,
                             t.max,
                             t.runs,
