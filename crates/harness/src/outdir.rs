@@ -260,6 +260,20 @@ mod tests {
         std::fs::remove_dir_all(d).unwrap();
     }
 
+    /// A drawing of another report may have had other scenes: its scene pages go too.
+    #[test]
+    fn an_earlier_drawing_s_scene_pages_count_as_its_output() {
+        let d = scratch("pages");
+        std::fs::write(d.join("scene-old.html"), "<html>").unwrap();
+        std::fs::write(d.join("scene-notes.txt"), "mine").unwrap();
+        let err = OutDir::claim(&d, DRAWING, false).unwrap_err().to_string();
+        assert!(err.contains("(scene-old.html): give --force"), "{err}");
+        OutDir::claim(&d, DRAWING, true).unwrap();
+        assert!(!d.join("scene-old.html").exists());
+        assert!(d.join("scene-notes.txt").exists());
+        std::fs::remove_dir_all(d).unwrap();
+    }
+
     #[test]
     fn a_directory_where_a_file_goes_is_an_error_even_with_force() {
         let d = scratch("kind");
