@@ -24,18 +24,27 @@ pub enum Output {
     Dir(&'static str),
     /// Every file whose name ends with this (the hit dumps' `*.hits`).
     FilesEndingWith(&'static str),
+    /// Every file whose name starts with the first and ends with the second (the scene pages'
+    /// `scene-*.html`).
+    FilesLike(&'static str, &'static str),
 }
 
 /// What `run` writes: the report, then its drawing.
 pub const RUN: &[Output] = &[
     Output::File("report.json"),
     Output::File("index.html"),
+    Output::File("charts.html"),
+    Output::File("details.html"),
+    Output::FilesLike("scene-", ".html"),
     Output::Dir("charts"),
     Output::Dir("images"),
 ];
 /// What `report` writes next to a report.
 pub const DRAWING: &[Output] = &[
     Output::File("index.html"),
+    Output::File("charts.html"),
+    Output::File("details.html"),
+    Output::FilesLike("scene-", ".html"),
     Output::Dir("charts"),
     Output::Dir("images"),
 ];
@@ -150,20 +159,25 @@ fn stale_outputs(dir: &Path, outputs: &[Output]) -> Result<Vec<PathBuf>> {
                 }
                 stale.push(p);
             }
-            Output::FilesEndingWith(suffix) => {
-                let entries =
-                    std::fs::read_dir(dir).with_context(|| format!("listing {}", dir.display()))?;
-                for entry in entries {
-                    let entry = entry.with_context(|| format!("listing {}", dir.display()))?;
-                    let is_file = entry.file_type().is_ok_and(|t| t.is_file());
-                    if is_file && entry.file_name().to_string_lossy().ends_with(suffix) {
-                        stale.push(entry.path());
-                    }
-                }
-            }
+            Output::FilesEndingWith(suffix) => files_like(dir, "", suffix, &mut stale)?,
+            Output::FilesLike(prefix, suffix) => files_like(dir, prefix, suffix, &mut stale)?,
         }
     }
     Ok(stale)
+}
+
+/// Adds the files of `dir` named `prefix…suffix` to `found`.
+fn files_like(dir: &Path, prefix: &str, suffix: &str, found: &mut Vec<PathBuf>) -> Result<()> {
+    let entries = std::fs::read_dir(dir).with_context(|| format!("listing {}", dir.display()))?;
+    for entry in entries {
+        let entry = entry.with_context(|| format!("listing {}", dir.display()))?;
+        let is_file = entry.file_type().is_ok_and(|t| t.is_file());
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if is_file && name.starts_with(prefix) && name.ends_with(suffix) {
+            found.push(entry.path());
+        }
+    }
+    Ok(())
 }
 
 fn kind(meta: &std::fs::Metadata) -> &'static str {
@@ -243,6 +257,20 @@ mod tests {
             d.join("notes.txt").exists(),
             "files raybench does not write are kept"
         );
+        std::fs::remove_dir_all(d).unwrap();
+    }
+
+    /// A drawing of another report may have had other scenes: its scene pages go too.
+    #[test]
+    fn an_earlier_drawing_s_scene_pages_count_as_its_output() {
+        let d = scratch("pages");
+        std::fs::write(d.join("scene-old.html"), "<html>").unwrap();
+        std::fs::write(d.join("scene-notes.txt"), "mine").unwrap();
+        let err = OutDir::claim(&d, DRAWING, false).unwrap_err().to_string();
+        assert!(err.contains("(scene-old.html): give --force"), "{err}");
+        OutDir::claim(&d, DRAWING, true).unwrap();
+        assert!(!d.join("scene-old.html").exists());
+        assert!(d.join("scene-notes.txt").exists());
         std::fs::remove_dir_all(d).unwrap();
     }
 

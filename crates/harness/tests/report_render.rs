@@ -1,12 +1,16 @@
 //! `raybench report`: every chart type from a real (small) report, heatmap sizes and value
-//! range, a static page without scripts, and — where Debian's Chromium is installed — the page
-//! and a chart rendered headless to a screenshot that is not blank.
+//! range, the site's pages (a short summary with the answer, the geometric means with their
+//! spread and the claims; a page per scene; charts; details with a readable environment),
+//! static but for the table-sorting script, and — where Debian's Chromium is installed — the
+//! pages rendered headless: not blank, the summary a few screens tall, the claims and the
+//! summary table in the rendered document.
 
 mod common;
 
 use raybench_harness::output::render::sweep::Sweep;
 use raybench_harness::output::render::{pictures, render};
 use raybench_harness::pipeline::run::run;
+use raybench_harness::report::claims::{Claim, Verdict};
 use raybench_harness::report::run::Report;
 use raybench_scenes::SceneRequest;
 use std::path::{Path, PathBuf};
@@ -34,13 +38,58 @@ fn report() -> &'static Report {
     })
 }
 
+/// The report with two claims, as the summary page shows them.
+fn with_claims() -> Report {
+    let mut r = report().clone();
+    let claim = |id: &str, verdict| Claim {
+        id: id.into(),
+        statement: format!("Claim {id} <with markup> holds"),
+        rule: "a rule & its threshold".into(),
+        verdict,
+        figures: vec!["1.2 against 1.0".into()],
+        note: None,
+    };
+    r.claims = vec![
+        claim("first", Verdict::Holds),
+        claim("second", Verdict::NotMeasured),
+    ];
+    r
+}
+
 fn rendered() -> &'static PathBuf {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
         let dir = std::env::temp_dir().join(format!("raybench-render-{}", std::process::id()));
-        render(report(), &dir).unwrap();
+        render(&with_claims(), &dir).unwrap();
         dir
     })
+}
+
+fn page(name: &str) -> String {
+    std::fs::read_to_string(rendered().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// Every page the summary links: (scene, file), from the answer table's first column.
+fn scene_pages() -> Vec<(String, String)> {
+    let html = page("index.html");
+    let answer = &html[html.find("id=\"answer\"").unwrap()..];
+    let answer = &answer[..answer.find("</table>").unwrap()];
+    answer
+        .split("<td class=\"l\"><a href=\"")
+        .skip(1)
+        .map(|s| {
+            let file = &s[..s.find('"').unwrap()];
+            let name = &s[s.find('>').unwrap() + 1..s.find("</a>").unwrap()];
+            (name.to_string(), file.to_string())
+        })
+        .collect()
+}
+
+/// The text between `start` and the next `end` after it.
+fn between<'a>(html: &'a str, start: &str, end: &str) -> &'a str {
+    let from = html.find(start).unwrap_or_else(|| panic!("no {start:?}"));
+    let rest = &html[from..];
+    &rest[..rest.find(end).unwrap_or(rest.len())]
 }
 
 #[test]
@@ -58,7 +107,7 @@ fn every_chart_type_is_drawn() {
             "break-even-sphere-triangles-2000.svg",
             "build + trace K rays",
         ),
-        ("agreement.svg", "Rays per agreement class"),
+        ("agreement.svg", "within tolerance: "),
     ] {
         let svg = std::fs::read_to_string(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(svg.starts_with("<svg"), "{file} is not an SVG");
@@ -167,38 +216,81 @@ fn heatmaps_have_the_image_size_and_span_the_shared_scale() {
     assert_eq!(*brute.iter().max().unwrap(), max);
 }
 
-#[test]
-fn the_page_is_static_and_links_everything_it_shows() {
-    let html = std::fs::read_to_string(rendered().join("index.html")).unwrap();
-    assert!(!html.to_lowercase().contains("<script"));
-    for needle in [
-        "charts/build-ms.svg",
-        "charts/scaling.svg",
-        "images/legend-viridis.png",
-        "cpu_model",
-        "0 mismatches",
-    ] {
-        assert!(html.contains(needle), "index.html lacks {needle}");
-    }
-    for src in html
-        .split("src=\"")
-        .skip(1)
-        .map(|s| &s[..s.find('"').unwrap()])
-    {
-        assert!(
-            rendered().join(src).is_file(),
-            "index.html links a missing file {src}"
-        );
-    }
+const PAGES: [&str; 3] = ["index.html", "charts.html", "details.html"];
+
+fn all_pages() -> Vec<String> {
+    PAGES
+        .iter()
+        .map(|p| p.to_string())
+        .chain(scene_pages().into_iter().map(|(_, f)| f))
+        .collect()
 }
 
+/// Static files: the only script is the inline one that sorts tables; every image and page a
+/// page links exists.
 #[test]
-fn the_page_opens_with_the_answer_per_scene_and_the_geometric_means() {
-    let html = std::fs::read_to_string(rendered().join("index.html")).unwrap();
+fn the_pages_are_static_and_link_everything_they_show() {
+    for name in all_pages() {
+        let html = page(&name);
+        assert_eq!(html.matches("<script").count(), 1, "{name}");
+        let script = between(&html, "<script>", "</script>");
+        assert!(script.contains("table.sortable"), "{name}: {script}");
+        for (attr, what) in [("src=\"", "file"), ("href=\"", "page")] {
+            for link in html.split(attr).skip(1).map(|s| &s[..s.find('"').unwrap()]) {
+                let link = link.split('#').next().unwrap();
+                if link.is_empty() {
+                    continue;
+                }
+                assert!(!link.contains("://"), "{name} links outside: {link}");
+                assert!(
+                    rendered().join(link).is_file(),
+                    "{name} links a missing {what} {link}"
+                );
+            }
+        }
+        for other in PAGES {
+            assert!(
+                html.contains(&format!("href=\"{other}\"")) || other == name,
+                "{name} has no link to {other}"
+            );
+        }
+    }
+    assert!(page("details.html").contains(">CPU<"));
+    assert!(page("index.html").contains("0 mismatches"));
+    let charts = page("charts.html");
+    for chart in [
+        "charts/build-ms.svg",
+        "charts/scaling.svg",
+        "charts/agreement.svg",
+    ] {
+        assert!(charts.contains(chart), "charts.html lacks {chart}");
+    }
+    assert!(
+        !charts.contains("charts/break-even-"),
+        "break-even charts belong on their scene's page"
+    );
+}
+
+/// The summary: the TOC, the answer per scene, the geometric means with their spread, the
+/// claims, and a link to every scene's page; no results table, no chart.
+#[test]
+fn the_summary_opens_with_the_answer_and_the_geometric_means_with_their_spread() {
+    let html = page("index.html");
+    let toc = between(&html, "On this page:", "</p>");
+    for id in ["#answer", "#geomeans", "#claims", "#more"] {
+        assert!(toc.contains(id), "the table of contents lacks {id}");
+        assert!(
+            html.contains(&format!("id=\"{}\"", &id[1..])),
+            "no section {id}"
+        );
+    }
     let answer = html.find("id=\"answer\"").expect("an answer section");
-    let results = html.find("<h2>Results</h2>").expect("a results table");
-    assert!(answer < results, "the answer comes before the tables");
-    let section = &html[answer..html.find("id=\"summary\"").expect("a summary table")];
+    let geomeans = html.find("id=\"geomeans\"").expect("a geomeans section");
+    let claims = html.find("id=\"claims\"").expect("a claims section");
+    assert!(answer < geomeans && geomeans < claims);
+    assert!(!html.contains("<img"), "the summary draws no chart");
+    assert!(!html.contains("class=\"sortable results\""));
+    let section = between(&html, "id=\"answer\"", "</table>");
     // One row per scene, each naming the fastest structure of each workload in bold.
     for scene in [
         "sphere:triangles=500",
@@ -217,10 +309,142 @@ fn the_page_opens_with_the_answer_per_scene_and_the_geometric_means() {
             "{row}"
         );
     }
-    // The geometric means: every structure but the reference, with its build ratio.
-    let summary = &html[html.find("id=\"summary\"").unwrap()..results];
-    assert!(summary.contains(">bvh-binned<") && summary.contains(">bruteforce<"));
-    assert!(!summary.contains(">embree-medium</td>"));
+    // The geometric means: every structure but the reference, each cell with its range over
+    // the four scenes.
+    let means = between(&html, "id=\"geomeans\"", "</table>");
+    assert!(means.contains("class=\"sortable geomeans\""));
+    assert!(means.contains(">bvh-binned<") && means.contains(">bruteforce<"));
+    assert!(!means.contains(">embree-medium</td>"));
+    let bvh = means
+        .split("<tr>")
+        .find(|r| r.contains(">bvh-binned<"))
+        .unwrap();
+    assert_eq!(bvh.matches("<small>").count(), 2 + 2, "{bvh}");
+    assert!(bvh.contains("lowest") && bvh.contains("highest"), "{bvh}");
+    // The claims, escaped.
+    let claims = between(&html, "id=\"claims\"", "</table>");
+    assert!(
+        claims.contains("Claim first &lt;with markup&gt; holds"),
+        "{claims}"
+    );
+    assert!(claims.contains("not measured in this run"), "{claims}");
+    // A link to every scene's page.
+    let linked: Vec<String> = scene_pages().into_iter().map(|(s, _)| s).collect();
+    let scenes: Vec<String> = report().scenes.iter().map(|s| s.name.clone()).collect();
+    assert_eq!(linked, scenes);
+}
+
+/// Each scene's page holds that scene's rows of the results, and only them, its break-even
+/// chart and its pictures.
+#[test]
+fn every_scene_has_a_page_with_its_rows_chart_and_pictures() {
+    for (scene, file) in scene_pages() {
+        assert!(
+            file.starts_with("scene-") && !file.contains('/'),
+            "{file}: scene pages sit beside index.html"
+        );
+        let html = page(&file);
+        assert!(
+            html.contains(&format!("<h1>raybench report: {scene}</h1>")),
+            "{file}"
+        );
+        let results: Vec<_> = report()
+            .results
+            .iter()
+            .filter(|r| r.scene == scene)
+            .collect();
+        let table = between(&html, "class=\"sortable results\"", "</table>");
+        let rows: Vec<&str> = table.split("<tr>").skip(2).collect();
+        assert_eq!(rows.len(), results.len(), "{file}");
+        for r in &results {
+            let row = rows
+                .iter()
+                .find(|row| row.starts_with(&format!("<td class=\"l st\">{}</td>", r.structure)))
+                .unwrap_or_else(|| panic!("{file} has no row for {}", r.structure));
+            assert!(
+                row.contains(&format!("<td>{}</td>", r.triangles.traced)),
+                "{file}: {row}"
+            );
+        }
+        assert!(html.contains("charts/break-even-"), "{file}");
+        assert!(html.contains("images/"), "{file} shows no picture");
+        assert!(html.contains("href=\"index.html\""), "{file}");
+    }
+}
+
+/// Tables of figures sort; the environment is a table of labelled values, not JSON.
+#[test]
+fn tables_sort_and_the_environment_reads_as_a_table() {
+    let details = page("details.html");
+    for class in ["sortable results", "sortable agreement"] {
+        assert!(
+            details.contains(&format!("<table class=\"{class}\"><thead>")),
+            "{class}"
+        );
+    }
+    let env = between(&details, "<table class=\"environment\">", "</table>");
+    for c in ['{', '}', '['] {
+        assert!(!env.contains(c), "raw JSON in the environment table: {env}");
+    }
+    for label in [
+        ">Machine<",
+        ">CPU<",
+        ">Embree<",
+        ">Run settings<",
+        ">units in the last place<",
+    ] {
+        assert!(env.contains(label), "the environment lacks {label}");
+    }
+    let structures = report().run.structures.join(", ");
+    assert!(env.contains(&structures), "lists are joined: {structures}");
+}
+
+/// The validation chart shows every class, each on its own linear scale: classes far smaller
+/// than the largest still get bars.
+#[test]
+fn the_agreement_chart_draws_every_class() {
+    let svg = std::fs::read_to_string(rendered().join("charts/agreement.svg")).unwrap();
+    for class in [
+        "both miss",
+        "exact",
+        "within tolerance",
+        "tie",
+        "boundary",
+        "edge ambiguous",
+        "mismatch",
+    ] {
+        // plotters writes a caption's text on a line of its own.
+        assert!(
+            svg.contains(&format!("\n{class}: ")),
+            "no panel for {class}"
+        );
+    }
+    let with_bars = [
+        "both miss",
+        "exact",
+        "within tolerance",
+        "tie",
+        "edge ambiguous",
+    ]
+    .iter()
+    .filter(|c| svg.contains(&format!("<title>{c}, ")))
+    .count();
+    assert!(with_bars >= 2, "only the largest class has bars");
+}
+
+/// The break-even chart marks where the fastest tracer starts to win, with its ray count.
+#[test]
+fn the_break_even_chart_marks_its_crossing_with_a_ray_count() {
+    let marked = scene_pages()
+        .iter()
+        .filter_map(|(_, file)| {
+            let html = page(file);
+            let src = between(&html, "charts/break-even-", "\"").to_string();
+            std::fs::read_to_string(rendered().join(src)).ok()
+        })
+        .filter(|svg| svg.contains("<title>From ") && svg.contains(" rays</text>"))
+        .count();
+    assert!(marked > 0, "no break-even chart marks its crossing");
 }
 
 /// Debian's Chromium, if installed (scripts/test installs it).
@@ -288,6 +512,125 @@ fn headless_chromium_renders_the_page_and_a_chart() {
         distinct_colours(&px, channels) > 8,
         "the chart screenshot is (nearly) blank"
     );
+}
+
+/// What a browser makes of a page at 1280 pixels wide: the document as rendered, its height
+/// and the natural width of each `img.picture`. A copy of the page, beside it so its links
+/// resolve, gets a script that writes both into an element once everything has loaded.
+struct Measured {
+    dom: String,
+    height: u32,
+    picture_widths: Vec<u32>,
+}
+
+fn measure(browser: &Path, page: &Path) -> Measured {
+    let html = std::fs::read_to_string(page).unwrap();
+    let probe = "<script>window.addEventListener('load', function () {\
+        var h = document.documentElement.scrollHeight;\
+        var w = Array.from(document.querySelectorAll('img.picture')).map(function (i) { return i.naturalWidth; });\
+        var e = document.createElement('pre'); e.id = 'raybench-measured';\
+        e.textContent = 'height=' + h + ';pictures=' + w.join(',') + ';';\
+        document.body.appendChild(e); });</script></body>";
+    assert!(html.contains("</body>"), "{}", page.display());
+    let copy = page.with_file_name(format!(
+        ".measure-{}",
+        page.file_name().unwrap().to_string_lossy()
+    ));
+    std::fs::write(&copy, html.replace("</body>", probe)).unwrap();
+    let out = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+            "--window-size=1280,1080",
+            "--virtual-time-budget=3000",
+            "--dump-dom",
+        ])
+        .arg(format!("file://{}", copy.display()))
+        .output()
+        .unwrap();
+    std::fs::remove_file(&copy).ok();
+    let dom = String::from_utf8_lossy(&out.stdout).into_owned();
+    let measured = dom
+        .split("id=\"raybench-measured\">")
+        .nth(1)
+        .and_then(|s| s.split('<').next())
+        .unwrap_or_else(|| {
+            panic!(
+                "{} was not measured: {}",
+                page.display(),
+                String::from_utf8_lossy(&out.stderr)
+            )
+        })
+        .to_string();
+    let field = |name: &str| {
+        measured
+            .split(&format!("{name}="))
+            .nth(1)
+            .and_then(|s| s.split(';').next())
+            .unwrap_or_default()
+            .to_string()
+    };
+    Measured {
+        height: field("height").parse().unwrap(),
+        picture_widths: field("pictures")
+            .split(',')
+            .filter(|s| !s.is_empty())
+            .map(|s| s.parse().unwrap())
+            .collect(),
+        dom,
+    }
+}
+
+/// Screens of 1080 pixels the summary may take at 1280 pixels wide.
+const SUMMARY_SCREENS: u32 = 4;
+
+/// In a browser the summary shows the claims and the summary table and stays a few screens
+/// tall; the scene pages show their pictures at full size (at least 640 pixels wide).
+#[test]
+fn headless_chromium_finds_a_short_summary_and_full_size_pictures() {
+    let Some(browser) = chromium() else {
+        eprintln!("NOT RUN: Chromium is not installed; the pages were checked as files only");
+        return;
+    };
+    let dir = rendered();
+    let summary = measure(&browser, &dir.join("index.html"));
+    assert!(summary.dom.contains("id=\"claims\""), "no claims section");
+    assert!(
+        summary.dom.contains("<table class=\"claims\">"),
+        "no claims table"
+    );
+    assert!(
+        summary.dom.contains("class=\"sortable geomeans\""),
+        "no summary table"
+    );
+    // The sorting script ran: every header of a sortable table can be focused.
+    assert!(summary.dom.contains("title=\"sort by this column\""));
+    eprintln!("the summary is {} pixels tall", summary.height);
+    assert!(
+        summary.height <= SUMMARY_SCREENS * 1080,
+        "the summary is {} pixels tall, more than {SUMMARY_SCREENS} screens",
+        summary.height
+    );
+    let widths: Vec<u32> = scene_pages()
+        .iter()
+        .flat_map(|(_, file)| measure(&browser, &dir.join(file)).picture_widths)
+        .collect();
+    // The pictures at full size arrive with the picture section's rework; until it is merged
+    // the page has none, and this check waits for RAYBENCH_EXPECT_FULL_PICTURES.
+    if std::env::var_os("RAYBENCH_EXPECT_FULL_PICTURES").is_some() {
+        assert!(!widths.is_empty(), "no img.picture on any scene page");
+        assert!(
+            widths.iter().all(|&w| w >= 640),
+            "pictures narrower than 640 pixels: {widths:?}"
+        );
+    } else {
+        eprintln!(
+            "NOT CHECKED: picture widths {widths:?} (set RAYBENCH_EXPECT_FULL_PICTURES to \
+             require at least one img.picture, each at least 640 pixels wide)"
+        );
+    }
 }
 
 /// Any finite value a report may hold is drawn: speedups of 5e-324 and 1.7e308, build times of

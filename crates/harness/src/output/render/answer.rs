@@ -6,7 +6,7 @@
 use super::names::{scene_names, workload_names};
 use super::page::escape;
 use super::ticks::tick_label;
-use crate::output::results::{cell, headline_rows, ratio_text};
+use crate::output::results::ratio_text;
 use crate::report::run::Report;
 use std::fmt::Write;
 
@@ -74,25 +74,70 @@ pub(crate) fn answer(report: &Report, scene: &str, workload: &str) -> Option<Ans
     })
 }
 
-/// The page's first section: the structures' geometric means against the reference, then one
-/// row per scene with each workload's answer.
-pub(crate) fn answer_section(s: &mut String, report: &Report) {
-    let workloads = workload_names(report);
+/// The summary's first section: one row per scene with each workload's answer, the scene
+/// linked to its page.
+pub(crate) fn answer_section(
+    s: &mut String,
+    report: &Report,
+    link: &dyn Fn(&str) -> Option<String>,
+) {
     s.push_str(
         "<h2 id=\"answer\">The answer</h2>\n<p class=\"note\">Per scene and workload: the \
          structure with the highest throughput, how much faster it is than the next one, and \
          from how many queries it also wins when each structure's build is counted (below that, \
-         the named structure wins because it builds faster). Medians of this run.</p>\n",
+         the named structure wins because it builds faster). Medians of this run. A scene's \
+         name leads to its page.</p>\n",
     );
+    answer_table(s, report, &scene_names(report), link);
+}
+
+/// Under a scene's name: its triangles, and its mismatches when there are any.
+fn scene_facts(report: &Report, scene: &str) -> String {
+    let results: Vec<_> = report.results.iter().filter(|r| r.scene == scene).collect();
+    let Some(first) = results.first() else {
+        return String::new();
+    };
+    let bad: u64 = results
+        .iter()
+        .flat_map(|r| &r.workloads)
+        .map(|w| w.agreement.counts.mismatch + w.agreement.counted_path_differs)
+        .sum();
+    let mut out = format!(
+        "<br><small>{} triangles",
+        tick_label(first.triangles.traced as f64)
+    );
+    if bad > 0 {
+        let _ = write!(out, "; <span class=\"bad\">{bad} mismatches</span>");
+    }
+    out.push_str("</small>");
+    out
+}
+
+/// The answer rows of `scenes`; a scene whose `link` is known is a link.
+pub(crate) fn answer_table(
+    s: &mut String,
+    report: &Report,
+    scenes: &[String],
+    link: &dyn Fn(&str) -> Option<String>,
+) {
+    let workloads = workload_names(report);
     s.push_str("<table class=\"answer\"><tr><th class=\"l\">scene</th>");
     for w in &workloads {
         let _ = write!(s, "<th class=\"l\">{}</th>", escape(w));
     }
     s.push_str("</tr>\n");
-    for scene in scene_names(report) {
-        let _ = write!(s, "<tr><td class=\"l\">{}</td>", escape(&scene));
+    for scene in scenes {
+        let name = match link(scene) {
+            Some(file) => format!("<a href=\"{}\">{}</a>", escape(&file), escape(scene)),
+            None => escape(scene),
+        };
+        let _ = write!(
+            s,
+            "<tr><td class=\"l\">{name}{}</td>",
+            scene_facts(report, scene)
+        );
         for w in &workloads {
-            match answer(report, &scene, w) {
+            match answer(report, scene, w) {
                 None => s.push_str("<td class=\"l\">–</td>"),
                 Some(a) => {
                     let _ = write!(s, "<td class=\"l\"><b>{}</b>", escape(&a.fastest));
@@ -117,44 +162,6 @@ pub(crate) fn answer_section(s: &mut String, report: &Report) {
             }
         }
         s.push_str("</tr>\n");
-    }
-    s.push_str("</table>\n");
-    summary_table(s, report, &workloads);
-}
-
-/// Each structure's geometric means over its scenes against the reference (the README's
-/// headline table).
-fn summary_table(s: &mut String, report: &Report, workloads: &[String]) {
-    let rows = headline_rows(report);
-    if rows.is_empty() {
-        return;
-    }
-    let _ = write!(
-        s,
-        "<h2 id=\"summary\">Geometric means against {}</h2>\n<p class=\"note\">Over the scenes \
-         each structure ran on: throughput relative to the reference (higher is faster), build \
-         time and memory relative to it (lower is better).</p>\n<table><tr><th \
-         class=\"l\">structure</th>",
-        escape(&report.run.reference)
-    );
-    for w in workloads {
-        let _ = write!(s, "<th>{}</th>", escape(w));
-    }
-    s.push_str("<th>build</th><th>memory</th><th>scenes</th></tr>\n");
-    for r in rows {
-        let _ = write!(s, "<tr><td class=\"l\">{}</td>", escape(&r.structure));
-        for w in workloads {
-            let i = report.run.workloads.iter().position(|x| x == w);
-            let v = i.and_then(|i| r.workloads.get(i).copied().flatten());
-            let _ = write!(s, "<td>{}</td>", cell(v));
-        }
-        let _ = writeln!(
-            s,
-            "<td>{}</td><td>{}</td><td>{}</td></tr>",
-            cell(r.build),
-            cell(r.memory),
-            r.scenes
-        );
     }
     s.push_str("</table>\n");
 }

@@ -1,7 +1,8 @@
 //! SVG charts drawn with plotters. Text is emitted as SVG `<text>` (plotters' naive font, and
 //! the [`Overlay`]'s own), so no font files are read at build or run time. Two shapes cover
 //! every chart: grouped bars (groups on x, one bar per series), here, and lines
-//! ([`super::lines`]). Both keep their legend in a column right of the plot.
+//! ([`super::lines`]). Both keep their legend in a column right of the plot and draw the
+//! fastest and slowest timed run as an error bar where the report has them.
 
 use super::legend::{self, Entry, LEGEND_W, Swatch};
 use super::overlay::{LabelLayout, Overlay, text_width};
@@ -17,6 +18,9 @@ pub struct Series {
     pub name: String,
     pub color: RGBColor,
     pub values: Vec<Option<f64>>,
+    /// Per group, the lowest and highest of the timed runs, drawn as an error bar over the
+    /// bar (empty: none).
+    pub ranges: Vec<Option<(f64, f64)>>,
 }
 
 /// A grouped bar chart.
@@ -240,17 +244,37 @@ where
             let a = chart.backend_coord(&rect[0]);
             let b = chart.backend_coord(&rect[1]);
             let value = series.values[g].unwrap_or_default();
+            let range = series
+                .ranges
+                .get(g)
+                .copied()
+                .flatten()
+                .filter(|&(lo, hi)| lo.is_finite() && hi.is_finite() && lo > 0.0 && hi > lo);
+            let spread = range.map_or(String::new(), |(lo, hi)| {
+                format!(" (runs from {} to {})", tick_label(lo), tick_label(hi))
+            });
             o.hover_rect(
                 (a.0 as f64, b.1 as f64),
                 (b.0 as f64, a.1 as f64),
                 &format!(
-                    "{}, {}: {} {}",
+                    "{}, {}: {} {}{spread}",
                     series.name,
                     c.group_title(g),
                     tick_label(value),
                     c.y_desc
                 ),
             );
+            if let Some((lo, hi)) = range {
+                // Drawn in black over the bar: the bar's own colour would vanish into it.
+                let x = (rect[0].0 + rect[1].0) / 2.0;
+                let (px, top) = chart.backend_coord(&(x, on_axis(hi)));
+                let (_, bottom) = chart.backend_coord(&(x, on_axis(lo)));
+                let (px, top, bottom) = (px as f64, top as f64, bottom as f64);
+                let half = ((b.0 - a.0) as f64 / 2.0).clamp(1.0, 4.0);
+                o.line((px, top), (px, bottom), BLACK, 1.0, None);
+                o.line((px - half, top), (px + half, top), BLACK, 1.0, None);
+                o.line((px - half, bottom), (px + half, bottom), BLACK, 1.0, None);
+            }
         }
     }
     for (g, label) in labels.iter().enumerate().step_by(layout.step) {

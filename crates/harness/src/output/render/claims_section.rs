@@ -71,6 +71,7 @@ pub(crate) fn claim_charts(report: &Report) -> Result<Vec<(String, String)>> {
                     ticks: Vec::new(),
                     lines,
                     references,
+                    marks: Vec::new(),
                 };
                 if !chart.has_data() {
                     continue;
@@ -101,6 +102,7 @@ pub(crate) fn claim_charts(report: &Report) -> Result<Vec<(String, String)>> {
                             },
                             name,
                             values,
+                            ranges: Vec::new(),
                         })
                         .collect(),
                     log_y,

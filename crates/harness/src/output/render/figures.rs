@@ -20,24 +20,49 @@ use plotters::style::RGBColor;
 /// A drawn chart: (file name, caption, SVG).
 pub(super) type Figure = (String, String, String);
 
+/// A drawn chart and the scene it is about, if one (its page shows it).
+pub(super) struct Drawn {
+    pub file: String,
+    pub caption: String,
+    pub svg: String,
+    pub scene: Option<String>,
+}
+
+impl Drawn {
+    fn across((file, caption, svg): Figure) -> Drawn {
+        Drawn {
+            file,
+            caption,
+            svg,
+            scene: None,
+        }
+    }
+}
+
+/// A value of one result, with the lowest and highest of its timed runs when it has them.
+type Measure<'a> = &'a dyn Fn(&ResultEntry) -> Option<(f64, Option<(f64, f64)>)>;
+
+/// The spread of timed runs, when there was more than one run and a real spread.
+fn runs(runs: usize, min: f64, max: f64) -> Option<(f64, f64)> {
+    (runs > 1 && min < max).then_some((min, max))
+}
+
 /// Groups = scenes, one series per structure, `value` of each result.
-fn bars(
-    report: &Report,
-    palette: &Palette,
-    title: String,
-    y_desc: &str,
-    value: impl Fn(&ResultEntry) -> Option<f64>,
-) -> Bars {
+fn bars(report: &Report, palette: &Palette, title: String, y_desc: &str, value: Measure) -> Bars {
     let scenes = scene_names(report);
     let series = structure_names(report)
         .into_iter()
-        .map(|st| Series {
-            values: scenes
+        .map(|st| {
+            let measured: Vec<_> = scenes
                 .iter()
-                .map(|sc| entry(report, sc, &st).and_then(&value))
-                .collect(),
-            color: palette.color(&st),
-            name: st,
+                .map(|sc| entry(report, sc, &st).and_then(value))
+                .collect();
+            Series {
+                values: measured.iter().map(|m| m.map(|m| m.0)).collect(),
+                ranges: measured.iter().map(|m| m.and_then(|m| m.1)).collect(),
+                color: palette.color(&st),
+                name: st,
+            }
         })
         .collect();
     Bars {
@@ -51,16 +76,17 @@ fn bars(
 }
 
 /// Every chart the report has data for.
-pub(super) fn all_charts(report: &Report, sweep: Option<&Sweep>) -> Result<Vec<Figure>> {
+pub(super) fn all_charts(report: &Report, sweep: Option<&Sweep>) -> Result<Vec<Drawn>> {
     let palette = Palette::for_report(report);
-    let mut out = match sweep {
+    let across = match sweep {
         Some(s) => sweep_charts(report, s, &palette)?,
         None => bar_charts(report, &palette)?,
     };
+    let mut out: Vec<Drawn> = across.into_iter().map(Drawn::across).collect();
     if let Some(sizes) = Sizes::of(report, sweep)
         && let Some(svg) = scaling_chart(report, &sizes, &palette)?
     {
-        out.push((
+        out.push(Drawn::across((
             "scaling.svg".into(),
             format!(
                 "Scaling with scene size ({}), log–log: each structure's exponent b fitted by least \
@@ -68,26 +94,34 @@ pub(super) fn all_charts(report: &Report, sweep: Option<&Sweep>) -> Result<Vec<F
                 sizes.family
             ),
             svg,
-        ));
+        )));
     }
     let slugs = scene_slugs(report);
     for scene in scene_names(report) {
         if let Some(svg) = break_even_chart(report, &scene, sweep, &palette)? {
-            out.push((
-                format!("break-even-{}.svg", slugs[&scene]),
-                format!("{scene}: total time to build once and trace K rays"),
+            out.push(Drawn {
+                file: format!("break-even-{}.svg", slugs[&scene]),
+                caption: format!(
+                    "{scene}: total time to build once and trace K rays; the ring marks where \
+                     the fastest tracer starts to win with its build counted"
+                ),
                 svg,
-            ));
+                scene: Some(scene),
+            });
         }
     }
     let reference = &report.run.reference;
-    let agreement = agreement_chart(report);
-    if agreement.has_data() {
-        out.push((
+    let agreement = agreement_panels(report);
+    if agreement.iter().any(Bars::has_data) {
+        out.push(Drawn::across((
             "agreement.svg".into(),
-            format!("Agreement classes per structure against {reference}, all scenes and workloads (log scale)"),
-            charts::bars_svg(&agreement, W, H)?,
-        ));
+            format!(
+                "Agreement with {reference} per validation class, all scenes and workloads: one \
+                 panel per class on its own linear scale, in queries per million each structure \
+                 answered (structures ran on different numbers of scenes)"
+            ),
+            charts::stacked_bars_svg(&agreement, W, 270)?,
+        )));
     }
     Ok(out)
 }
@@ -102,21 +136,22 @@ fn bar_charts(report: &Report, palette: &Palette) -> Result<Vec<Figure>> {
         }
         Ok(())
     };
-    let bars = |title: String, y_desc: &str, value: &dyn Fn(&ResultEntry) -> Option<f64>| {
-        bars(report, palette, title, y_desc, value)
-    };
+    let bars =
+        |title: String, y_desc: &str, value: Measure| bars(report, palette, title, y_desc, value);
+    let plain = |v: Option<f64>| v.map(|v| (v, None));
     push(
         "build-ms.svg".into(),
-        "Build time (median), log scale".into(),
+        "Build time (median; error bars: fastest to slowest build), log scale".into(),
         &bars("Build time".into(), "ms (median)", &|r| {
-            Some(r.build.median_ms)
+            let b = &r.build;
+            Some((b.median_ms, runs(b.runs, b.min_ms, b.max_ms)))
         }),
     )?;
     push(
         "ratio-build.svg".into(),
         format!("Build time relative to {reference} in the same run (lower is faster)"),
         &bars(format!("Build time / {reference}"), "ratio", &|r| {
-            r.build_ratio_to_reference
+            plain(r.build_ratio_to_reference)
         }),
     )?;
     for wl in workload_names(report) {
@@ -125,9 +160,15 @@ fn bar_charts(report: &Report, palette: &Palette) -> Result<Vec<Figure>> {
         let unit = throughput_unit(&wl);
         push(
             format!("mrays-{}.svg", slug(&wl)),
-            format!("Throughput on `{wl}` (median {unit}), log scale"),
+            format!(
+                "Throughput on `{wl}` (median {unit}; error bars: slowest to fastest pass), \
+                 log scale"
+            ),
             &bars(format!("{wl}: {unit}"), &format!("{unit} (median)"), &|r| {
-                find(r).map(|w| w.mqueries_per_s.median)
+                find(r).map(|w| {
+                    let t = &w.mqueries_per_s;
+                    (t.median, runs(t.runs, t.min, t.max))
+                })
             }),
         )?;
         push(
@@ -136,7 +177,7 @@ fn bar_charts(report: &Report, palette: &Palette) -> Result<Vec<Figure>> {
                 "Throughput on `{wl}` relative to {reference} in the same run (higher is faster)"
             ),
             &bars(format!("{wl}: {unit} / {reference}"), "ratio", &|r| {
-                find(r).and_then(|w| w.speedup_vs_reference)
+                plain(find(r).and_then(|w| w.speedup_vs_reference))
             }),
         )?;
     }
@@ -144,7 +185,9 @@ fn bar_charts(report: &Report, palette: &Palette) -> Result<Vec<Figure>> {
         "memory-per-triangle.svg".into(),
         "Memory per triangle (bytes the structure holds / traced triangles)".into(),
         &bars("Memory per triangle".into(), "bytes", &|r| {
-            (r.triangles.traced > 0).then(|| r.memory_bytes as f64 / r.triangles.traced as f64)
+            plain(
+                (r.triangles.traced > 0).then(|| r.memory_bytes as f64 / r.triangles.traced as f64),
+            )
         }),
     )?;
 
@@ -156,7 +199,7 @@ fn bar_charts(report: &Report, palette: &Palette) -> Result<Vec<Figure>> {
                     .iter()
                     .find(|w| w.workload == wl)
                     .and_then(|w| w.counters_per_query.as_ref())
-                    .map(f)
+                    .map(|c| (f(c), None))
             }
         };
         let panels = [
@@ -191,49 +234,73 @@ fn bar_charts(report: &Report, palette: &Palette) -> Result<Vec<Figure>> {
 /// How many rays of an agreement class.
 type ClassCount = fn(&raybench_accel::classify::VerdictCounts) -> u64;
 
-/// Rays per agreement class and structure: groups are structures, series the classes, in
-/// colours that read as verdicts (green agrees, red is a mismatch).
-fn agreement_chart(report: &Report) -> Bars {
+/// The validation classes, each with a colour that reads as a verdict (greens agree, red is a
+/// mismatch).
+const CLASSES: [(&str, RGBColor, ClassCount); 7] = [
+    ("both miss", RGBColor(116, 196, 118), |c| c.both_miss),
+    ("exact", RGBColor(44, 160, 44), |c| c.exact),
+    ("within tolerance", RGBColor(0, 109, 44), |c| {
+        c.within_tolerance
+    }),
+    ("tie", RGBColor(31, 119, 180), |c| c.tie),
+    ("boundary", RGBColor(148, 103, 189), |c| c.boundary),
+    ("edge ambiguous", RGBColor(255, 127, 14), |c| {
+        c.edge_ambiguous
+    }),
+    ("mismatch", RGBColor(214, 39, 40), |c| c.mismatch),
+];
+
+/// One panel per validation class, structures on x, each on its own linear scale: a log
+/// scale over all classes together let 99.9 % of agreeing rays hide every other class, and
+/// a share per structure (a stacked bar) does the same. Values are per million queries, as
+/// structures skipped on large scenes answered fewer queries than the others. A class no
+/// query fell in keeps its panel, empty, with "no query" in its title.
+fn agreement_panels(report: &Report) -> Vec<Bars> {
     let structures = structure_names(report);
-    let classes: [(&str, RGBColor, ClassCount); 5] = [
-        (
-            "agree (both miss, exact, within tolerance)",
-            RGBColor(44, 160, 44),
-            |c| c.both_miss + c.exact + c.within_tolerance,
-        ),
-        ("tie", RGBColor(31, 119, 180), |c| c.tie),
-        ("boundary", RGBColor(148, 103, 189), |c| c.boundary),
-        ("edge ambiguous", RGBColor(255, 127, 14), |c| {
-            c.edge_ambiguous
-        }),
-        ("mismatch", RGBColor(214, 39, 40), |c| c.mismatch),
-    ];
-    let series = classes
+    let totals: Vec<(raybench_accel::classify::VerdictCounts, u64)> = structures
         .iter()
-        .map(|(name, color, f)| Series {
-            name: name.to_string(),
-            color: *color,
-            values: structures
+        .map(|st| {
+            let mut c = raybench_accel::classify::VerdictCounts::default();
+            for w in report
+                .results
                 .iter()
-                .map(|st| {
-                    let n: u64 = report
-                        .results
-                        .iter()
-                        .filter(|r| &r.structure == st)
-                        .flat_map(|r| &r.workloads)
-                        .map(|w| f(&w.agreement.counts))
-                        .sum();
-                    (n > 0).then_some(n as f64)
-                })
-                .collect(),
+                .filter(|r| &r.structure == st)
+                .flat_map(|r| &r.workloads)
+            {
+                c += w.agreement.counts;
+            }
+            let total = c.total();
+            (c, total)
         })
         .collect();
-    Bars {
-        title: "Rays per agreement class".into(),
-        y_desc: "rays".into(),
-        group_titles: structures.clone(),
-        groups: structures,
-        series,
-        log_y: true,
-    }
+    CLASSES
+        .iter()
+        .map(|(name, color, f)| {
+            let all: u64 = totals.iter().map(|(c, _)| f(c)).sum();
+            let values = totals
+                .iter()
+                .map(|(c, total)| {
+                    let n = f(c);
+                    (n > 0 && *total > 0).then(|| n as f64 * 1e6 / *total as f64)
+                })
+                .collect();
+            Bars {
+                title: if all == 0 {
+                    format!("{name}: no query in any structure")
+                } else {
+                    format!("{name}: {all} queries in all")
+                },
+                y_desc: "per million queries".into(),
+                group_titles: structures.clone(),
+                groups: structures.clone(),
+                series: vec![Series {
+                    name: name.to_string(),
+                    color: *color,
+                    values,
+                    ranges: Vec::new(),
+                }],
+                log_y: false,
+            }
+        })
+        .collect()
 }

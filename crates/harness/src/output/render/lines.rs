@@ -44,6 +44,17 @@ pub struct Reference {
     pub points: Vec<(f64, f64)>,
 }
 
+/// A point to point out: a ring at `(x, y)`, a dotted drop to the x axis and a label (the
+/// break-even chart's crossings, "2.9k rays").
+#[derive(Clone, Debug)]
+pub struct Mark {
+    pub x: f64,
+    pub y: f64,
+    pub label: String,
+    /// Shown on hover: what the mark means.
+    pub title: String,
+}
+
 /// An x tick at a given value.
 #[derive(Clone, Debug)]
 pub struct Tick {
@@ -62,6 +73,7 @@ pub struct LineChart {
     pub ticks: Vec<Tick>,
     pub lines: Vec<Line>,
     pub references: Vec<Reference>,
+    pub marks: Vec<Mark>,
 }
 
 fn ok(v: f64) -> bool {
@@ -357,6 +369,23 @@ where
             let (px, py) = chart.backend_coord(&at);
             o.hover_circle((px as f64, py as f64), 6.0, &p.title);
         }
+    }
+    for (i, m) in c
+        .marks
+        .iter()
+        .filter(|m| usable(m.x) && ok(m.y))
+        .enumerate()
+    {
+        let (px, py) = chart.backend_coord(&(m.x, m.y));
+        let (_, bottom) = chart.backend_coord(&(m.x, y_lo));
+        let (px, py, bottom) = (px as f64, py as f64, bottom as f64);
+        o.line((px, py), (px, bottom), BLACK, 1.0, Some("2 3"));
+        o.ring((px, py), 6.0, BLACK);
+        // Above the point, on a halo over the lines; a second mark's label goes below its
+        // point so that two crossings close together keep their labels apart.
+        let dy = if i % 2 == 0 { -16.0 } else { 16.0 };
+        o.callout((px + 6.0, py + dy), &m.label, &m.title);
+        o.hover_circle((px, py), 8.0, &m.title);
     }
     let visible: Vec<&Tick> = c.ticks.iter().filter(|t| usable(t.x)).collect();
     for t in visible.iter().step_by(layout.step) {

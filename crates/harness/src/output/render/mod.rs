@@ -1,24 +1,32 @@
-//! `raybench report`: charts, pictures and one static HTML page, drawn from `report.json` alone.
+//! `raybench report`: charts, pictures and a small static site, drawn from `report.json` alone.
 //!
 //! Output layout under the chosen directory:
+//! * `index.html` — the summary: the run, the answer per scene and workload, each structure's
+//!   geometric means with their spread, the claims, links to every other page; a few screens
+//!   tall whatever the suite;
+//! * `scene-<slug>.html` — one per scene: its results, break-even chart and pictures;
+//! * `charts.html` — the charts across scenes; `details.html` — every result, the agreement
+//!   per class, notes and errors, the environment;
 //! * `charts/*.svg` — build time, Mrays/s (Mqueries/s for closest-point workloads) and ratios
 //!   to the reference per workload, memory per triangle, counters per query (bars per scene, or
 //!   lines against the swept parameter when the report is a sweep), scaling curves with fitted
 //!   exponents and theory slopes (when the scenes grow), break-even per scene, validation
 //!   classes; one colour per structure throughout;
 //! * `images/*.png` — per scene and structure: traversal-cost heatmap (one colour scale per
-//!   scene), shaded render, disagreement mask; one legend colour bar;
-//! * `index.html` — tables (with the fitted exponents of a size sweep), the charts, the
-//!   pictures and the environment; no JavaScript.
+//!   scene), shaded render, disagreement mask; one legend colour bar.
 //!
-//! Every file is written atomically (a temporary file, then a rename).
+//! The pages are static; a few lines of inline script sort the tables, and every page reads
+//! the same without it. Every file is written atomically (a temporary file, then a rename).
 
 mod answer;
 mod break_even;
 pub mod charts;
 mod claims_section;
+mod details_page;
+mod environment;
 mod figures;
 pub mod fit;
+mod geomeans;
 mod legend;
 pub mod lines;
 pub mod names;
@@ -29,8 +37,11 @@ mod picture_files;
 mod picture_section;
 pub mod pictures;
 mod scaling;
+mod scene_page;
+mod summary_page;
 pub mod sweep;
 mod sweep_charts;
+mod tables;
 pub mod ticks;
 
 use crate::atomic::write_atomic;
@@ -50,7 +61,10 @@ const H: u32 = 520;
 pub struct Rendered {
     pub charts: Vec<PathBuf>,
     pub images: Vec<PathBuf>,
+    /// The summary page.
     pub index: PathBuf,
+    /// Every page: the summary, the scene pages, the charts and the details.
+    pub pages: Vec<PathBuf>,
 }
 
 /// A chart as the page shows it.
@@ -58,6 +72,9 @@ pub struct Rendered {
 pub(crate) struct ChartFile {
     pub file: String,
     pub caption: String,
+    /// The scene a chart is about (a break-even chart), shown on its page; `None`: across
+    /// scenes, shown on the charts page.
+    pub scene: Option<String>,
 }
 
 /// Pictures of one scene.
@@ -78,13 +95,14 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
     let mut out = Rendered::default();
     let mut chart_files = Vec::new();
     let sweep = Sweep::detect(report);
-    for (file, caption, svg) in all_charts(report, sweep.as_ref())? {
-        let path = dir.join("charts").join(&file);
-        write_atomic(&path, svg.as_bytes())?;
+    for c in all_charts(report, sweep.as_ref())? {
+        let path = dir.join("charts").join(&c.file);
+        write_atomic(&path, c.svg.as_bytes())?;
         out.charts.push(path);
         chart_files.push(ChartFile {
-            file: format!("charts/{file}"),
-            caption,
+            file: format!("charts/{}", c.file),
+            caption: c.caption,
+            scene: c.scene,
         });
     }
     let mut claim_charts = Vec::new();
@@ -96,17 +114,36 @@ pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
     }
     let pictures = picture_files::write_pictures(report, dir, &mut out.images)?;
     let exponents = Sizes::of(report, sweep.as_ref()).map(|sizes| Exponents::of(report, &sizes));
-    let page = page::page(
+    let site = page::Site::new(
         report,
-        &page::Extras {
-            charts: &chart_files,
-            pictures: &pictures,
-            sweep: sweep.as_ref(),
-            exponents: exponents.as_ref(),
-            claim_charts: &claim_charts,
-        },
+        &chart_files,
+        &pictures,
+        sweep.as_ref(),
+        exponents.as_ref(),
+        &claim_charts,
     );
-    out.index = dir.join("index.html");
-    write_atomic(&out.index, page.as_bytes())?;
+    let mut pages = vec![(
+        page::SUMMARY_FILE.to_string(),
+        summary_page::summary_page(&site),
+    )];
+    for (scene, file) in &site.scenes {
+        pages.push((file.clone(), scene_page::scene_page(&site, scene)));
+    }
+    pages.push((
+        page::CHARTS_FILE.to_string(),
+        details_page::charts_page(&site),
+    ));
+    pages.push((
+        page::DETAILS_FILE.to_string(),
+        details_page::details_page(&site),
+    ));
+    // The summary last: a reader who finds `index.html` finds the pages it links.
+    pages.rotate_left(1);
+    for (file, html) in pages {
+        let path = dir.join(file);
+        write_atomic(&path, html.as_bytes())?;
+        out.pages.push(path);
+    }
+    out.index = dir.join(page::SUMMARY_FILE);
     Ok(out)
 }

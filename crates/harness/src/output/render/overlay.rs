@@ -78,6 +78,19 @@ impl Overlay {
         );
     }
 
+    /// A bold label on a white halo, readable over the lines it sits on.
+    pub fn callout(&mut self, (x, y): (f64, f64), text: &str, title: &str) {
+        let _ = writeln!(
+            self.svg,
+            "<text x=\"{x:.1}\" y=\"{y:.1}\" dy=\"0.35em\" text-anchor=\"start\" \
+             font-family=\"sans-serif\" font-size=\"{}\" font-weight=\"bold\" fill=\"#000000\" \
+             stroke=\"#ffffff\" stroke-width=\"4\" paint-order=\"stroke\"><title>{}</title>{}</text>",
+            FONT + 1.0,
+            xml(title),
+            xml(text)
+        );
+    }
+
     /// A line segment; `dash` is an SVG `stroke-dasharray` ("8 4").
     pub fn line(
         &mut self,
@@ -110,6 +123,16 @@ impl Overlay {
         let _ = writeln!(
             self.svg,
             "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"{r}\" fill=\"{}\"/>",
+            hex(color)
+        );
+    }
+
+    /// An unfilled circle, to point a spot out.
+    pub fn ring(&mut self, (x, y): (f64, f64), r: f64, color: RGBColor) {
+        let _ = writeln!(
+            self.svg,
+            "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"{r}\" fill=\"none\" stroke=\"{}\" \
+             stroke-width=\"1.5\"/>",
             hex(color)
         );
     }

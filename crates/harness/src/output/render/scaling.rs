@@ -297,6 +297,7 @@ pub(super) fn scaling_chart(
             ticks: ticks.clone(),
             references: references(&lines, n0, n1, laws),
             lines,
+            marks: Vec::new(),
         }
     };
     let panels: Vec<LineChart> = [

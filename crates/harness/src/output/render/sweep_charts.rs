@@ -73,6 +73,7 @@ fn chart(
         ticks: sweep_ticks(sweep),
         lines,
         references: Vec::new(),
+        marks: Vec::new(),
     }
 }
 
