@@ -57,7 +57,7 @@ fn toc(s: &mut String, site: &Site) {
         ("answer", "The answer"),
         ("geomeans", "Geometric means and their spread"),
     ];
-    if !site.report.claims.is_empty() {
+    if !crate::report::claims::of_report(site.report).is_empty() {
         sections.push(("claims", "Claims"));
     }
     if site.exponents.is_some() {
