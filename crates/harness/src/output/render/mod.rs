@@ -15,8 +15,8 @@
 
 mod answer;
 mod break_even;
-mod claims_section;
 pub mod charts;
+mod claims_section;
 mod figures;
 pub mod fit;
 mod legend;
@@ -24,9 +24,9 @@ pub mod lines;
 pub mod names;
 mod overlay;
 mod page;
+pub mod palette;
 mod picture_files;
 mod picture_section;
-pub mod palette;
 pub mod pictures;
 mod scaling;
 pub mod sweep;
@@ -60,14 +60,22 @@ pub(crate) struct ChartFile {
     pub caption: String,
 }
 
-/// Pictures of one scene.
+/// Pictures of one scene, as a page shows them (paths relative to the page's directory).
 #[derive(Clone, Debug)]
 pub(crate) struct ScenePictures {
     pub scene: String,
-    pub max_cost: u16,
-    pub downsample: u32,
-    /// (structure, heatmap file if counted, render file, mask file)
-    pub rows: Vec<(String, Option<String>, String, String)>,
+    /// Pixel size of the picture files.
+    pub width: u32,
+    pub height: u32,
+    /// The top of the scene's colour scale: the largest cost per pixel of any structure.
+    pub max_cost: u64,
+    /// Why the small planes of report.json were drawn instead of full-size files; `None` when
+    /// the files are full size.
+    pub fallback: Option<String>,
+    /// The structure whose hits are shaded, and the render file.
+    pub render: Option<(String, String)>,
+    /// Per structure: its heatmap (absent: not counted) and mask (absent: agrees everywhere).
+    pub structures: Vec<crate::pipeline::picture::StructurePicture>,
 }
 
 pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {
