@@ -55,6 +55,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         points: DEFAULT_POINTS,
     };
     let r = args.selection.resolve(true, defaults)?;
+    if !args.no_images {
+        check_picture_memory(args.picture_width, r.structures.len())?;
+    }
     registry::find(&args.reference)?;
     let claimed = claim_outputs(
         args.out.as_deref(),
@@ -139,4 +142,19 @@ fn picture_width(text: &str) -> Result<u32, String> {
             "must be a whole number of pixels from {lo} to {hi}"
         )),
     }
+}
+
+/// Refuses a picture width whose per-scene pictures would not fit in half of this machine's
+/// memory, before any work.
+fn check_picture_memory(width: u32, structures: usize) -> Result<()> {
+    let need = picture::picture_bytes(width, structures);
+    let have = super::bounds::physical_memory();
+    anyhow::ensure!(
+        need <= have / 2,
+        "--picture-width {width} needs about {:.1} GiB per scene with {structures} structures, \
+         more than half of this machine's {:.1} GiB: give a smaller width or --no-images",
+        need as f64 / f64::from(1u32 << 30),
+        have as f64 / f64::from(1u32 << 30)
+    );
+    Ok(())
 }

@@ -28,8 +28,8 @@ use std::time::{Duration, Instant};
 
 pub use super::picture_set::{PictureSet, StructurePicture};
 
-/// Bounds of `--picture-width`: 64 pixels is the smallest picture worth looking at, 4096 keeps
-/// a scene's heatmaps in memory under ~300 MB (2 bytes × 4096 × 3072 per counting structure).
+/// Bounds of `--picture-width`: 64 pixels is the smallest picture worth looking at; at 4096 a
+/// scene's pictures hold about 2 GB with a dozen structures ([`picture_bytes`]).
 pub const MIN_WIDTH: u32 = 64;
 pub const MAX_WIDTH: u32 = 4096;
 pub const DEFAULT_WIDTH: u32 = 640;
@@ -40,6 +40,18 @@ const CHUNK: usize = 4096;
 
 /// `ln(1 + cost)` in steps of 1/2900: `ln(1 + u32::MAX) × 2900 = 64,325` fits a `u16`.
 const LOG_STEPS: f64 = 2900.0;
+
+/// Bytes a scene's picture pass holds per pixel while it runs: the ray (44), the reference's
+/// and the structure's hits (20 each), the work, level and shade, and the RGB row of the PNG
+/// being written, rounded up; plus 2 per counting structure for the waiting heatmaps.
+const BYTES_PER_PIXEL: u64 = 128;
+const BYTES_PER_HEATMAP_PIXEL: u64 = 2;
+
+/// Bytes the pictures of one scene need at `width` with `structures` structures.
+pub fn picture_bytes(width: u32, structures: usize) -> u64 {
+    let pixels = u64::from(width) * u64::from(picture_height(width));
+    pixels * (BYTES_PER_PIXEL + BYTES_PER_HEATMAP_PIXEL * structures as u64)
+}
 
 /// The height of a `width`-wide picture at the workload's 4:3 aspect.
 pub fn picture_height(width: u32) -> u32 {
@@ -228,6 +240,53 @@ mod tests {
         assert_eq!(picture_height(64), 48);
         assert_eq!(picture_height(365), 274);
         assert_eq!(picture_height(4096), 3072);
+    }
+
+    /// The reference against itself and an agreeing twin get no mask; a structure built on a
+    /// smaller sphere (it answers for other geometry) gets one, with mismatches counted; every
+    /// structure counts, so each gets a heatmap, and the files are `width × height`.
+    #[test]
+    fn masks_are_written_only_for_structures_that_disagree() {
+        use raybench_accel::{BruteForce, BruteForceParams};
+        let load = |spec: &str| {
+            raybench_scenes::SceneRequest::Spec(spec.into())
+                .load(1)
+                .unwrap()
+                .unwrap()
+        };
+        let scene = load("sphere:triangles=200");
+        let smaller = load("sphere:triangles=200,radius=0.6");
+        assert_eq!(scene.mesh.len(), smaller.mesh.len());
+        let params = BruteForceParams::default();
+        let reference = BruteForce::build(scene.mesh.clone(), &params).unwrap();
+        let twin = BruteForce::build(scene.mesh.clone(), &params).unwrap();
+        let wrong = BruteForce::build(smaller.mesh.clone(), &params).unwrap();
+        let dir = std::env::temp_dir().join(format!("raybench-picture-{}", std::process::id()));
+        let mut pass =
+            ScenePicturePass::start(&dir, "s".into(), 64, &scene, &reference, "ref", 1).unwrap();
+        let tol = Tolerance::default();
+        for (name, accel) in [("ref", &reference), ("twin", &twin), ("wrong", &wrong)] {
+            pass.add(name, accel, &scene.mesh, &reference, &tol)
+                .unwrap();
+        }
+        let set = pass.finish().unwrap();
+        assert_eq!((set.width, set.height), (64, 48));
+        assert_eq!(set.render, "images/s--render-64x48.png");
+        let masks: Vec<_> = set.structures.iter().map(|s| s.mask.is_some()).collect();
+        assert_eq!(masks, [false, false, true]);
+        assert!(set.structures[2].mismatch_pixels > 0);
+        assert_eq!(
+            set.structures[1].explained_pixels + set.structures[1].mismatch_pixels,
+            0
+        );
+        assert!(set.structures.iter().all(|s| s.heatmap.is_some()));
+        assert!(
+            set.max_cost >= 200,
+            "brute force tests every triangle: {}",
+            set.max_cost
+        );
+        assert_eq!(set.check_files(&dir), Ok(()));
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
