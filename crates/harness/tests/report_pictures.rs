@@ -158,8 +158,8 @@ fn pictures_change_no_counter_or_agreement_count() {
                 "{what}"
             );
             assert_eq!(
-                serde_json::to_value(&x.agreement.counts).unwrap(),
-                serde_json::to_value(&y.agreement.counts).unwrap(),
+                serde_json::to_value(x.agreement.counts).unwrap(),
+                serde_json::to_value(y.agreement.counts).unwrap(),
                 "{what}"
             );
             assert_eq!(x.queries, y.queries, "{what}");
