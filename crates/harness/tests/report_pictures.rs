@@ -201,7 +201,7 @@ fn a_moved_report_falls_back_to_small_planes_and_says_so() {
     let listed: Vec<String> = report
         .pictures
         .iter()
-        .flat_map(|p| p.files().cloned())
+        .flat_map(|p| p.files().into_iter().cloned())
         .collect();
     let report_arg = home.join("report.json").display().to_string();
 

@@ -73,6 +73,10 @@ pub(crate) struct ScenePicturePass {
     structures: Vec<StructurePicture>,
     /// (index into `structures`, log-quantized cost per pixel)
     heat: Vec<(usize, Vec<u16>)>,
+    /// The masks written so far and their levels per pixel: structures that disagree at the
+    /// same pixels in the same way (often every structure against one grazing decision of the
+    /// reference) share one file instead of repeating a picture.
+    masks: Vec<(String, Vec<u8>)>,
     max_cost: u64,
     elapsed: Duration,
 }
@@ -114,6 +118,7 @@ impl ScenePicturePass {
             shade,
             structures: Vec::new(),
             heat: Vec::new(),
+            masks: Vec::new(),
             max_cost: 0,
             elapsed: start.elapsed(),
         })
@@ -152,6 +157,7 @@ impl ScenePicturePass {
             mask: None,
             explained_pixels: 0,
             mismatch_pixels: 0,
+            pass_ms: 0.0,
         };
         // The reference agrees with itself by definition; its counted walk may still decide a
         // grazing ray differently from its batch path, which the workloads report already.
@@ -165,9 +171,7 @@ impl ScenePicturePass {
             entry.explained_pixels = levels.iter().filter(|&&l| l == 1).count() as u64;
             entry.mismatch_pixels = levels.iter().filter(|&&l| l >= 2).count() as u64;
             if entry.explained_pixels + entry.mismatch_pixels > 0 {
-                let file = self.file(&format!("{}-disagree", slug(name)));
-                self.write(&mask_rgb(&self.shade, &levels), &file)?;
-                entry.mask = Some(file);
+                entry.mask = Some(self.mask_file(name, levels)?);
             }
         }
         if accel.has_counters() {
@@ -177,6 +181,7 @@ impl ScenePicturePass {
             let quantized = work.iter().map(|&c| log_step(c)).collect();
             self.heat.push((self.structures.len(), quantized));
         }
+        entry.pass_ms = start.elapsed().as_secs_f64() * 1e3;
         self.structures.push(entry);
         self.elapsed += start.elapsed();
         Ok(())
@@ -205,6 +210,18 @@ impl ScenePicturePass {
             structures: self.structures,
             pass_ms: self.elapsed.as_secs_f64() * 1e3,
         })
+    }
+
+    /// The mask file for `levels`: an earlier structure's when they are the same, else a new one.
+    fn mask_file(&mut self, name: &str, levels: Vec<u8>) -> Result<String> {
+        if let Some((file, _)) = self.masks.iter().find(|(_, l)| *l == levels) {
+            return Ok(file.clone());
+        }
+        let file = self.file(&format!("{}-disagree", slug(name)));
+        let pixels = mask_rgb(&self.shade, &levels, self.width as usize);
+        self.write(&pixels, &file)?;
+        self.masks.push((file.clone(), levels));
+        Ok(file)
     }
 
     /// `images/<base>--<what>-<W>x<H>.png`: the size in the name keeps these apart from the
@@ -243,7 +260,8 @@ mod tests {
     }
 
     /// The reference against itself and an agreeing twin get no mask; a structure built on a
-    /// smaller sphere (it answers for other geometry) gets one, with mismatches counted; every
+    /// smaller sphere (it answers for other geometry) gets one, with mismatches counted, shared
+    /// with a second structure that disagrees at the same pixels in the same way; every
     /// structure counts, so each gets a heatmap, and the files are `width × height`.
     #[test]
     fn masks_are_written_only_for_structures_that_disagree() {
@@ -265,7 +283,13 @@ mod tests {
         let mut pass =
             ScenePicturePass::start(&dir, "s".into(), 64, &scene, &reference, "ref", 1).unwrap();
         let tol = Tolerance::default();
-        for (name, accel) in [("ref", &reference), ("twin", &twin), ("wrong", &wrong)] {
+        let structures = [
+            ("ref", &reference),
+            ("twin", &twin),
+            ("wrong", &wrong),
+            ("wrong-too", &wrong),
+        ];
+        for (name, accel) in structures {
             pass.add(name, accel, &scene.mesh, &reference, &tol)
                 .unwrap();
         }
@@ -273,7 +297,10 @@ mod tests {
         assert_eq!((set.width, set.height), (64, 48));
         assert_eq!(set.render, "images/s--render-64x48.png");
         let masks: Vec<_> = set.structures.iter().map(|s| s.mask.is_some()).collect();
-        assert_eq!(masks, [false, false, true]);
+        assert_eq!(masks, [false, false, true, true]);
+        // The same disagreement is one file, not two copies.
+        assert_eq!(set.structures[3].mask, set.structures[2].mask);
+        assert_eq!(set.files().len(), 1 + 4 + 1);
         assert!(set.structures[2].mismatch_pixels > 0);
         assert_eq!(
             set.structures[1].explained_pixels + set.structures[1].mismatch_pixels,

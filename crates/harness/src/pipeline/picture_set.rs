@@ -32,23 +32,32 @@ pub struct StructurePicture {
     pub structure: String,
     /// The traversal-cost heatmap; absent for a structure that cannot count (Embree).
     pub heatmap: Option<String>,
-    /// The disagreement mask; absent when the structure agrees with the reference at every pixel.
+    /// The disagreement mask; absent when the structure agrees with the reference at every
+    /// pixel. Structures that disagree at the same pixels in the same way share one file.
     pub mask: Option<String>,
     /// Pixels that differ from the reference for an explained reason (tie, boundary,
     /// edge-ambiguous).
     pub explained_pixels: u64,
     /// Pixels that are mismatches.
     pub mismatch_pixels: u64,
+    /// Wall time of this structure's picture pass (counted walk, check, mask), milliseconds.
+    #[serde(default)]
+    pub pass_ms: f64,
 }
 
 impl PictureSet {
-    /// Every file the set lists, as paths relative to the report's directory.
-    pub fn files(&self) -> impl Iterator<Item = &String> {
-        std::iter::once(&self.render).chain(
-            self.structures
-                .iter()
-                .flat_map(|s| s.heatmap.iter().chain(s.mask.iter())),
-        )
+    /// Every file the set lists, once each (structures may share a mask), as paths relative
+    /// to the report's directory.
+    pub fn files(&self) -> Vec<&String> {
+        let mut files = vec![&self.render];
+        for st in &self.structures {
+            for f in st.heatmap.iter().chain(st.mask.iter()) {
+                if !files.contains(&f) {
+                    files.push(f);
+                }
+            }
+        }
+        files
     }
 
     /// `Ok` when every file of the set is in `dir` as a PNG of the set's size; otherwise why not.

@@ -86,6 +86,7 @@ fn small_pictures(
     pictures::write(&pictures::shade_pixels(img)?, img, &dir.join(&render))?;
     written.push(dir.join(&render));
     let mut structures = Vec::new();
+    let mut masks: Vec<(String, Vec<u8>)> = Vec::new();
     for r in entries {
         let img = r.primary_image.as_ref().expect("filtered");
         let file = |kind: &str| format!("images/{base}--{}-{kind}.png", slug(&r.structure));
@@ -101,13 +102,16 @@ fn small_pictures(
         let levels = img.disagree_values().map_err(anyhow::Error::msg)?;
         let explained = levels.iter().filter(|&&l| l == 1).count() as u64;
         let mismatched = levels.iter().filter(|&&l| l >= 2).count() as u64;
-        let mask = if explained + mismatched > 0 {
+        let mask = if explained + mismatched == 0 {
+            None
+        } else if let Some((f, _)) = masks.iter().find(|(_, l)| *l == levels) {
+            Some(f.clone())
+        } else {
             let f = file("disagree");
             pictures::write(&pictures::disagree_pixels(img)?, img, &dir.join(&f))?;
             written.push(dir.join(&f));
+            masks.push((f.clone(), levels));
             Some(f)
-        } else {
-            None
         };
         structures.push(StructurePicture {
             structure: r.structure.clone(),
@@ -115,6 +119,7 @@ fn small_pictures(
             mask,
             explained_pixels: explained,
             mismatch_pixels: mismatched,
+            pass_ms: 0.0,
         });
     }
     Ok(ScenePictures {

@@ -29,7 +29,9 @@ pub(crate) fn explanation(s: &mut String) {
          per pixel, on one logarithmic colour scale per scene, so structures can be compared by \
          eye. The render shades the reference's closest hits. A mask shows where a structure's \
          answer differs from the reference's: amber for an explained difference (tie, boundary, \
-         edge-ambiguous), red for a mismatch. Click a picture for the full-size file.</p>\n",
+         edge-ambiguous), red for a mismatch, each ringed by a paler halo so that a single pixel \
+         can be found; structures that differ at the same pixels share one mask. Click a \
+         picture for the full-size file.</p>\n",
     );
 }
 
@@ -89,15 +91,33 @@ pub(crate) fn scene_pictures(s: &mut String, p: &ScenePictures) {
             escape(&uncounted)
         );
     }
-    let masks: Vec<_> = p.structures.iter().filter(|st| st.mask.is_some()).collect();
+    // One figure per mask file: structures that disagree at the same pixels share one.
+    let mut masks: Vec<(&str, Vec<&str>, u64, u64)> = Vec::new();
+    for st in &p.structures {
+        let Some(file) = st.mask.as_deref() else {
+            continue;
+        };
+        match masks.iter_mut().find(|m| m.0 == file) {
+            Some(m) => m.1.push(&st.structure),
+            None => masks.push((
+                file,
+                vec![&st.structure],
+                st.explained_pixels,
+                st.mismatch_pixels,
+            )),
+        }
+    }
     if !masks.is_empty() {
         s.push_str("<div style=\"display:flex;flex-wrap:wrap;gap:12px\">\n");
-        for st in masks {
+        for (file, structures, explained, mismatched) in masks {
             let caption = format!(
-                "{}: {} pixels differ for an explained reason, {} mismatch",
-                st.structure, st.explained_pixels, st.mismatch_pixels
+                "{}: {} differ{} for an explained reason, {}",
+                structures.join(", "),
+                count(explained, "pixel"),
+                if explained == 1 { "s" } else { "" },
+                count(mismatched, "mismatch")
             );
-            figure(s, class, st.mask.as_deref().unwrap_or_default(), &caption);
+            figure(s, class, file, &caption);
         }
         s.push_str("</div>\n");
     }
@@ -124,6 +144,16 @@ fn names(
         .map(|st| st.structure.as_str())
         .collect();
     kept.join(", ")
+}
+
+/// `1 pixel`, `2 pixels`, `0 mismatches`.
+fn count(n: u64, noun: &str) -> String {
+    let plural = if noun.ends_with('h') { "es" } else { "s" };
+    format!(
+        "{} {noun}{}",
+        thousands(n),
+        if n == 1 { "" } else { plural }
+    )
 }
 
 /// One picture at display size, linked to its file, captioned and titled.

@@ -78,9 +78,13 @@ pub fn render_rgb(shade: &[u8]) -> Vec<[u8; 3]> {
         .collect()
 }
 
-/// Agreeing pixels as a dim version of the render, explained differences amber, mismatches red.
-pub fn mask_rgb(shade: &[u8], levels: &[u8]) -> Vec<[u8; 3]> {
-    shade
+/// Agreeing pixels as a dim version of the render, explained differences amber, mismatches red;
+/// each disagreeing pixel also gets a half-tone halo [`HALO`] pixels wide per 640 of width, so
+/// that a single one can be found in a picture shown smaller than its file. The pixel itself
+/// keeps the full colour.
+pub fn mask_rgb(shade: &[u8], levels: &[u8], width: usize) -> Vec<[u8; 3]> {
+    let colour = |d: u8| if d == 1 { [255, 191, 0] } else { [230, 20, 20] };
+    let mut out: Vec<[u8; 3]> = shade
         .iter()
         .zip(levels)
         .map(|(&s, &d)| match d {
@@ -88,11 +92,30 @@ pub fn mask_rgb(shade: &[u8], levels: &[u8]) -> Vec<[u8; 3]> {
                 let v = 20 + (s as u32 * 60 / 255) as u8;
                 [v, v, v]
             }
-            1 => [255, 191, 0],
-            _ => [230, 20, 20],
+            d => colour(d),
         })
-        .collect()
+        .collect();
+    let width = width.max(1);
+    let height = levels.len() / width;
+    let r = (HALO * width).div_ceil(640);
+    for (i, &d) in levels.iter().enumerate().filter(|(_, d)| **d > 0) {
+        let (x, y) = (i % width, i / width);
+        for yy in y.saturating_sub(r)..(y + r + 1).min(height) {
+            for xx in x.saturating_sub(r)..(x + r + 1).min(width) {
+                let j = yy * width + xx;
+                if levels[j] == 0 {
+                    let [a, b, c] = colour(d);
+                    let [p, q, s] = out[j];
+                    out[j] = [a / 2 + p / 2, b / 2 + q / 2, c / 2 + s / 2];
+                }
+            }
+        }
+    }
+    out
 }
+
+/// Halo radius of a disagreeing pixel in a 640-wide mask.
+pub const HALO: usize = 4;
 
 pub fn shade_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
     Ok(render_rgb(&img.shade_values().map_err(|e| anyhow!(e))?))
@@ -101,7 +124,7 @@ pub fn shade_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
 pub fn disagree_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
     let shade = img.shade_values().map_err(|e| anyhow!(e))?;
     let d = img.disagree_values().map_err(|e| anyhow!(e))?;
-    Ok(mask_rgb(&shade, &d))
+    Ok(mask_rgb(&shade, &d, img.width as usize))
 }
 
 /// The largest cost of any structure's image of a scene: one colour scale per scene.
