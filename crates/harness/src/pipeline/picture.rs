@@ -34,8 +34,8 @@ pub const MIN_WIDTH: u32 = 64;
 pub const MAX_WIDTH: u32 = 4096;
 pub const DEFAULT_WIDTH: u32 = 640;
 
-/// Rays per rayon task of the picture pass: each task counts its own rays, so the per-pixel
-/// costs are exact whatever the thread count.
+/// Rays per rayon task of the picture pass (run inside [`pool`]): each task counts its own rays,
+/// so the per-pixel costs are exact whatever the thread count.
 const CHUNK: usize = 4096;
 
 /// `ln(1 + cost)` in steps of 1/2900: `ln(1 + u32::MAX) × 2900 = 64,325` fits a `u16`.
@@ -51,6 +51,19 @@ const BYTES_PER_HEATMAP_PIXEL: u64 = 2;
 pub fn picture_bytes(width: u32, structures: usize) -> u64 {
     let pixels = u64::from(width) * u64::from(picture_height(width));
     pixels * (BYTES_PER_PIXEL + BYTES_PER_HEATMAP_PIXEL * structures as u64)
+}
+
+/// The pool picture passes run in: every core of the machine, whatever the run's `--threads`
+/// (the pass is untimed and runs between timed passes, never beside one), with the run's FPU
+/// state on every worker so its answers are the ones the timed threads would give.
+pub(crate) fn pool(ftz: bool) -> Result<rayon::ThreadPool> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(cores)
+        .thread_name(|i| format!("raybench-picture-{i}"))
+        .start_handler(move |_| raybench_embree::fpu::set_ftz_daz(ftz))
+        .build()
+        .context("creating the picture pass's thread pool")
 }
 
 /// The height of a `width`-wide picture at the workload's 4:3 aspect.
@@ -193,10 +206,17 @@ impl ScenePicturePass {
         let render = self.file("render");
         self.write(&render_rgb(&self.shade), &render)?;
         let top = log_step(self.max_cost.min(u64::from(u32::MAX)) as u32);
-        for (i, quantized) in std::mem::take(&mut self.heat) {
-            let name = slug(&self.structures[i].structure);
-            let file = self.file(&format!("{name}-cost"));
-            self.write(&heat_rgb(&quantized, top), &file)?;
+        let heat = std::mem::take(&mut self.heat);
+        let written: Vec<(usize, String)> = heat
+            .par_iter()
+            .map(|(i, quantized)| {
+                let name = slug(&self.structures[*i].structure);
+                let file = self.file(&format!("{name}-cost"));
+                self.write(&heat_rgb(quantized, top), &file)?;
+                Ok((*i, file))
+            })
+            .collect::<Result<_>>()?;
+        for (i, file) in written {
             self.structures[i].heatmap = Some(file);
         }
         self.elapsed += start.elapsed();

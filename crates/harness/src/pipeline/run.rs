@@ -128,6 +128,10 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
         pictures: Vec::new(),
     };
     let mut picture_names = std::collections::HashSet::new();
+    let picture_pool = opts
+        .picture_dir()
+        .map(|_| picture::pool(opts.ftz_daz))
+        .transpose()?;
 
     workers.pool.install(|| {
         for_each_scene(scenes, opts.seed, &progress, &mut log, |_, scene, log| {
@@ -142,12 +146,13 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
                 Err(e) => return log.errors.push(format!("scene {name}: {e:#}")),
             };
             report.scenes.push(sr.record(scene));
-            let mut pictures = opts.picture_dir().and_then(|dir| {
+            let mut pictures = opts.picture_dir().zip(picture_pool.as_ref()).and_then(|(dir, pool)| {
                 let base = unique_base(&mut picture_names, name);
-                let started = catch_panic(|| {
-                    ScenePicturePass::start(dir, base, opts.picture_width, &scene.scene, sr.reference.as_ref(), &sr.reference_name, opts.threads)
-                });
-                started.map_err(|e| log.errors.push(format!("pictures of {name}: {e:#}"))).ok()
+                let started = catch_panic(|| pool.install(|| {
+                    let threads = pool.current_num_threads();
+                    ScenePicturePass::start(dir, base, opts.picture_width, &scene.scene, sr.reference.as_ref(), &sr.reference_name, threads)
+                }));
+                started.map(|pass| (pass, pool)).map_err(|e| log.errors.push(format!("pictures of {name}: {e:#}"))).ok()
             });
             for entry in &structures {
                 if let Some(limit) = entry.suite_triangle_limit.filter(|&l| opts.suite_limits && scene.scene.mesh.len() > l) {
@@ -170,16 +175,16 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
                         continue;
                     }
                 };
-                if let Some(p) = pictures.as_mut() {
+                if let Some((p, pool)) = pictures.as_mut() {
                     let mesh = &scene.scene.mesh;
-                    let added = catch_panic(|| p.add(entry.name, built.accel.as_ref(), mesh, sr.reference.as_ref(), &tol));
+                    let added = catch_panic(|| pool.install(|| p.add(entry.name, built.accel.as_ref(), mesh, sr.reference.as_ref(), &tol)));
                     if let Err(e) = added {
                         log.errors.push(format!("pictures of {} on {name}: {e:#}", entry.name));
                     }
                 }
             }
-            if let Some(p) = pictures {
-                match catch_panic(|| p.finish()) {
+            if let Some((p, pool)) = pictures {
+                match catch_panic(|| pool.install(|| p.finish())) {
                     Ok(set) => report.pictures.push(set),
                     Err(e) => log.errors.push(format!("pictures of {name}: {e:#}")),
                 }
