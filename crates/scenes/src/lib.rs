@@ -38,7 +38,7 @@ pub use suite::{Suite, SuiteScene, list_suites, load_suite, suites_dir};
 pub use view::{Camera, View};
 pub use workload::{
     SHADOW_T_MAX, SurfaceHit, SurfacePoint, WhittedParams, Workload, diffuse_rays, primary_rays,
-    random_rays, shadow_rays, surface_point, whitted_children,
+    primary_rays_sized, random_rays, shadow_rays, surface_point, whitted_children,
 };
 
 use raybench_geom::{RemovedTriangles, TriangleMesh};

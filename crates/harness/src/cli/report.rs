@@ -1,7 +1,8 @@
 //! `raybench report`: draw a report again from its JSON alone (charts, pictures, index.html).
 
-use crate::outdir::{self, OutDir};
+use crate::outdir::{self, OutDir, Output};
 use crate::output::render::{Rendered, render};
+use crate::pipeline::picture_set::copy_pictures;
 use crate::report::run::Report;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -28,10 +29,12 @@ pub fn run(args: ReportArgs) -> Result<ExitCode> {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+    let at_home = args.out.as_ref().is_none_or(|dir| same_dir(dir, &own_dir));
     let claimed = match &args.out {
-        // Redrawing a report where it lives replaces its own earlier drawing.
-        None => OutDir::claim(&own_dir, outdir::DRAWING, true),
-        Some(dir) if same_dir(dir, &own_dir) => OutDir::claim(dir, outdir::DRAWING, true),
+        // Redrawing a report where it lives replaces its own earlier drawing, but keeps the
+        // run's full-resolution pictures in images/.
+        None => OutDir::claim(&own_dir, REDRAW, true),
+        Some(dir) if at_home => OutDir::claim(dir, REDRAW, true),
         // Elsewhere, a drawing already there belongs to another report, and so would a
         // drawing next to another report.json.
         Some(dir) => {
@@ -44,11 +47,22 @@ pub fn run(args: ReportArgs) -> Result<ExitCode> {
         }
     }
     .context("--out")?;
-    let drawn = render(&report, claimed.path())
+    let copied = if at_home {
+        Vec::new()
+    } else {
+        copy_pictures(&report.pictures, &own_dir, claimed.path())?
+    };
+    let mut drawn = render(&report, claimed.path())
         .with_context(|| format!("drawing {}", args.report.display()))?;
+    drawn.images.extend(copied);
     print_rendered(&drawn);
     Ok(ExitCode::SUCCESS)
 }
+
+/// What redrawing a report in its own directory replaces: the drawing, not `images/`, which
+/// holds the run's full-resolution pictures (the small pictures drawn there are overwritten
+/// under the same names).
+const REDRAW: &[Output] = &[Output::File("index.html"), Output::Dir("charts")];
 
 /// Whether two paths name one directory (both exist once claimed; compared canonically).
 fn same_dir(a: &Path, b: &Path) -> bool {

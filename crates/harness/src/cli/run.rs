@@ -5,6 +5,7 @@ use super::{DEFAULT_POINTS, Defaults, Selection, all_structures, claim_outputs, 
 use crate::outdir;
 use crate::output::render::render;
 use crate::output::summary::summary_table;
+use crate::pipeline::picture;
 use crate::pipeline::run::{RunOptions, run as run_pipeline};
 use crate::registry;
 use anyhow::Result;
@@ -34,9 +35,14 @@ pub struct RunArgs {
     /// (without it, such a directory is refused).
     #[arg(long)]
     force: bool,
-    /// Leave the per-pixel pictures of primary rays out of the report (smaller; for baselines).
+    /// Leave every per-pixel picture of primary rays out: no picture pass, no PNG files, no
+    /// small planes in the report (smaller and quicker; for baselines).
     #[arg(long)]
     no_images: bool,
+    /// Width in pixels of the full-resolution pictures (64 to 4096; the height is 3/4 of it),
+    /// drawn by an untimed pass from the primary workload's view into <out>/images.
+    #[arg(long, value_name = "W", default_value_t = picture::DEFAULT_WIDTH, value_parser = picture_width)]
+    picture_width: u32,
     /// Write every ray and each structure's answer here (see docs/report-format.md, "Hit dumps").
     #[arg(long)]
     dump_hits: Option<PathBuf>,
@@ -49,6 +55,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         points: DEFAULT_POINTS,
     };
     let r = args.selection.resolve(true, defaults)?;
+    if !args.no_images {
+        check_picture_memory(args.picture_width, r.structures.len())?;
+    }
     registry::find(&args.reference)?;
     let claimed = claim_outputs(
         args.out.as_deref(),
@@ -74,6 +83,8 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         progress: std::io::stdout().is_terminal(),
         images: !args.no_images,
         dump_hits: args.dump_hits.clone(),
+        picture_dir: Some(dir.to_path_buf()),
+        picture_width: args.picture_width,
     };
     let report = run_pipeline(&opts, &r.requests)?;
     let path = report.write_atomic(dir)?;
@@ -91,7 +102,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     // The report is safe on disk first: a drawing failure is reported and fails the command
     // (exit 1 unless a mismatch says 2), but never loses the report.
     let drawn = match render(&report, dir) {
-        Ok(r) => {
+        Ok(mut r) => {
+            let pictures = report.pictures.iter().flat_map(|p| p.files());
+            r.images.extend(pictures.map(|f| dir.join(f)));
             print_rendered(&r);
             true
         }
@@ -114,4 +127,34 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         report.mismatches(),
         report.errors.len() + usize::from(!drawn),
     ))
+}
+
+/// `--picture-width`: a whole number of pixels within [`picture::MIN_WIDTH`] and
+/// [`picture::MAX_WIDTH`].
+fn picture_width(text: &str) -> Result<u32, String> {
+    let (lo, hi) = (picture::MIN_WIDTH, picture::MAX_WIDTH);
+    match text.trim().parse::<u64>() {
+        Ok(w) if (u64::from(lo)..=u64::from(hi)).contains(&w) => Ok(w as u32),
+        Ok(_) => Err(format!(
+            "must be {lo} to {hi} pixels (the height is three quarters of the width)"
+        )),
+        Err(_) => Err(format!(
+            "must be a whole number of pixels from {lo} to {hi}"
+        )),
+    }
+}
+
+/// Refuses a picture width whose per-scene pictures would not fit in half of this machine's
+/// memory, before any work.
+fn check_picture_memory(width: u32, structures: usize) -> Result<()> {
+    let need = picture::picture_bytes(width, structures);
+    let have = super::bounds::physical_memory();
+    anyhow::ensure!(
+        need <= have / 2,
+        "--picture-width {width} needs about {:.1} GiB per scene with {structures} structures, \
+         more than half of this machine's {:.1} GiB: give a smaller width or --no-images",
+        need as f64 / f64::from(1u32 << 30),
+        have as f64 / f64::from(1u32 << 30)
+    );
+    Ok(())
 }

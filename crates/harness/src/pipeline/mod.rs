@@ -7,6 +7,8 @@ pub mod check;
 pub mod dump;
 pub mod images;
 pub mod measure;
+pub mod picture;
+pub mod picture_set;
 pub mod replay;
 pub mod run;
 pub mod scenes;

@@ -13,10 +13,11 @@ use super::images::{PixelInput, PrimaryImage, shade};
 use super::measure::{
     Answers, count_pass, count_point_pass, time_builds, time_point_queries, time_traces,
 };
+use super::picture::{self, ScenePicturePass};
 use super::scenes::for_each_scene;
 use super::workers::{Log, Progress, Workers, catch_panic};
 use super::workloads::{PreparedPoints, QueryCounts, SceneRun, prepare_workload, triangle_counts};
-use crate::registry::{self, BuildContext, StructureEntry};
+use crate::registry::{self, BuildContext, Built, StructureEntry};
 use crate::report::Header;
 use crate::report::run::*;
 use anyhow::Result;
@@ -49,6 +50,23 @@ pub struct RunOptions {
     pub images: bool,
     /// Write every structure's answers to every workload here (see [`super::dump`]).
     pub dump_hits: Option<PathBuf>,
+    /// The run's output directory: with `images`, full-resolution pictures of the primary view
+    /// go to its `images/` (see [`super::picture`]). `None` keeps only the small planes.
+    pub picture_dir: Option<PathBuf>,
+    /// Width of those pictures in pixels ([`picture::MIN_WIDTH`] to [`picture::MAX_WIDTH`]);
+    /// the height is three quarters of it.
+    pub picture_width: u32,
+}
+
+impl RunOptions {
+    /// Where the full-resolution pictures go, if they are drawn: pictures on, a directory
+    /// given, and the primary workload among the workloads (the pictures show its view).
+    fn picture_dir(&self) -> Option<&std::path::Path> {
+        let primary = self.workloads.contains(&Workload::Primary);
+        self.picture_dir
+            .as_deref()
+            .filter(|_| self.images && primary)
+    }
 }
 
 /// Runs everything and returns the report (not yet written). With `dump_hits`, every
@@ -56,6 +74,13 @@ pub struct RunOptions {
 pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
     anyhow::ensure!(opts.rays >= 1, "--rays must be at least 1 (got 0)");
     anyhow::ensure!(opts.points >= 1, "--points must be at least 1 (got 0)");
+    anyhow::ensure!(
+        (picture::MIN_WIDTH..=picture::MAX_WIDTH).contains(&opts.picture_width),
+        "--picture-width must be {} to {} pixels (got {})",
+        picture::MIN_WIDTH,
+        picture::MAX_WIDTH,
+        opts.picture_width
+    );
     let mut structures = registry::select(&opts.structures)?;
     let reference_entry = registry::find(&opts.reference)?;
     let mut log = Log::default();
@@ -100,7 +125,13 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
         notes: Vec::new(),
         errors: Vec::new(),
         claims: Vec::new(),
+        pictures: Vec::new(),
     };
+    let mut picture_names = std::collections::HashSet::new();
+    let picture_pool = opts
+        .picture_dir()
+        .map(|_| picture::pool(opts.ftz_daz))
+        .transpose()?;
 
     workers.pool.install(|| {
         for_each_scene(scenes, opts.seed, &progress, &mut log, |_, scene, log| {
@@ -115,6 +146,14 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
                 Err(e) => return log.errors.push(format!("scene {name}: {e:#}")),
             };
             report.scenes.push(sr.record(scene));
+            let mut pictures = opts.picture_dir().zip(picture_pool.as_ref()).and_then(|(dir, pool)| {
+                let base = unique_base(&mut picture_names, name);
+                let started = catch_panic(|| pool.install(|| {
+                    let threads = pool.current_num_threads();
+                    ScenePicturePass::start(dir, base, opts.picture_width, &scene.scene, sr.reference.as_ref(), &sr.reference_name, threads)
+                }));
+                started.map(|pass| (pass, pool)).map_err(|e| log.errors.push(format!("pictures of {name}: {e:#}"))).ok()
+            });
             for entry in &structures {
                 if let Some(limit) = entry.suite_triangle_limit.filter(|&l| opts.suite_limits && scene.scene.mesh.len() > l) {
                     log.notes.push(format!(
@@ -126,9 +165,28 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
                     continue;
                 }
                 progress.step(format!("{name}: {}", entry.name));
-                match catch_panic(|| sr.measure(entry, opts, &tol, dump.as_mut())) {
-                    Ok(r) => report.results.push(r),
-                    Err(e) => log.errors.push(format!("{} on {name}: {e:#}", entry.name)),
+                let built = match catch_panic(|| sr.measure(entry, opts, &tol, dump.as_mut())) {
+                    Ok((r, built)) => {
+                        report.results.push(r);
+                        built
+                    }
+                    Err(e) => {
+                        log.errors.push(format!("{} on {name}: {e:#}", entry.name));
+                        continue;
+                    }
+                };
+                if let Some((p, pool)) = pictures.as_mut() {
+                    let mesh = &scene.scene.mesh;
+                    let added = catch_panic(|| pool.install(|| p.add(entry.name, built.accel.as_ref(), mesh, sr.reference.as_ref(), &tol)));
+                    if let Err(e) = added {
+                        log.errors.push(format!("pictures of {} on {name}: {e:#}", entry.name));
+                    }
+                }
+            }
+            if let Some((p, pool)) = pictures {
+                match catch_panic(|| pool.install(|| p.finish())) {
+                    Ok(set) => report.pictures.push(set),
+                    Err(e) => log.errors.push(format!("pictures of {name}: {e:#}")),
                 }
             }
         });
@@ -154,7 +212,7 @@ impl SceneRun<'_> {
         opts: &RunOptions,
         tol: &Tolerance,
         mut dump: Option<&mut DumpDir>,
-    ) -> Result<ResultEntry> {
+    ) -> Result<(ResultEntry, Built)> {
         let s = &self.scene.scene;
         let ctx = BuildContext {
             threads: opts.threads,
@@ -229,7 +287,7 @@ impl SceneRun<'_> {
             workloads.push(self.measure_points(accel, pw, opts));
         }
         let memory = accel.memory();
-        Ok(ResultEntry {
+        let entry = ResultEntry {
             scene: s.name.clone(),
             triangles: triangle_counts(s),
             structure: entry.name.to_string(),
@@ -241,7 +299,8 @@ impl SceneRun<'_> {
             build_stats: accel.build_stats(),
             workloads,
             primary_image,
-        })
+        };
+        Ok((entry, built))
     }
 
     /// One structure on one closest-point workload: timed like rays (warm-up, median of
@@ -280,6 +339,18 @@ impl SceneRun<'_> {
             agreement,
         }
     }
+}
+
+/// A file-name base for a scene's pictures, unique in the run (`a:b` and `a-b` share a slug).
+fn unique_base(used: &mut std::collections::HashSet<String>, scene: &str) -> String {
+    let base = crate::output::render::names::slug(scene);
+    let mut candidate = base.clone();
+    let mut k = 2;
+    while !used.insert(candidate.clone()) {
+        candidate = format!("{base}-{k}");
+        k += 1;
+    }
+    candidate
 }
 
 /// Ratios to the reference measured in the same run: build time and throughput per workload.

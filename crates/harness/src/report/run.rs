@@ -33,6 +33,10 @@ pub struct Report {
     /// The claims this run's data decides (see [`super::claims`]); empty in older reports.
     #[serde(default)]
     pub claims: Vec<super::claims::Claim>,
+    /// Full-resolution pictures of the primary view, one entry per scene that has them (see
+    /// docs/report-format.md, "Pictures"); empty in older reports and runs without pictures.
+    #[serde(default)]
+    pub pictures: Vec<crate::pipeline::picture::PictureSet>,
 }
 
 /// The knobs of the run itself.

@@ -23,6 +23,8 @@ pub fn options(structures: &[&str]) -> RunOptions {
         progress: false,
         images: true,
         dump_hits: None,
+        picture_dir: None,
+        picture_width: 640,
     }
 }
 

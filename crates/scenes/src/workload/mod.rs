@@ -12,7 +12,7 @@ mod primary;
 mod secondary;
 mod whitted;
 
-pub use primary::{primary_rays, random_rays};
+pub use primary::{primary_rays, primary_rays_sized, random_rays};
 pub use secondary::{
     SHADOW_T_MAX, SurfaceHit, SurfacePoint, diffuse_rays, shadow_rays, surface_point,
 };

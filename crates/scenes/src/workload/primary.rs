@@ -18,12 +18,27 @@ pub fn primary_rays(view: &View, bounds: &Aabb, n: usize) -> (Vec<Ray>, u32, u32
         View::of_bounds(bounds)
     };
     let (width, height) = image_size(n);
+    (
+        primary_rays_sized(&view, bounds, width, height),
+        width,
+        height,
+    )
+}
+
+/// The camera rays of [`primary_rays`] for an exact `width × height` image (the same view,
+/// pixel centres and order), for pictures drawn at another size than the timed workload's.
+/// Either side 0 gives no rays.
+pub fn primary_rays_sized(view: &View, bounds: &Aabb, width: u32, height: u32) -> Vec<Ray> {
+    let view = if view.is_usable() {
+        *view
+    } else {
+        View::of_bounds(bounds)
+    };
     let frame = CameraFrame::new(&view, width, height);
-    let rays = (0..height)
+    (0..height)
         .flat_map(|y| (0..width).map(move |x| (x, y)))
         .map(|(x, y)| frame.ray(x, y))
-        .collect();
-    (rays, width, height)
+        .collect()
 }
 
 /// The 4:3 image with about `n` pixels: `W = round(sqrt(4n/3))`, `H = round(n / W)`.
@@ -122,5 +137,17 @@ mod tests {
             }
         }
         assert_eq!(image_size(0), (0, 0));
+    }
+
+    #[test]
+    fn sized_rays_match_the_workload_rays_at_the_same_size() {
+        let bounds = Aabb::new(Vec3::splat(-1.0), Vec3::ONE);
+        let view = View::of_bounds(&bounds);
+        let (rays, w, h) = primary_rays(&view, &bounds, 20_000);
+        assert_eq!(primary_rays_sized(&view, &bounds, w, h), rays);
+        let big = primary_rays_sized(&view, &bounds, 640, 480);
+        assert_eq!(big.len(), 640 * 480);
+        assert!(big.iter().all(|r| r.check().is_ok()));
+        assert!(primary_rays_sized(&view, &bounds, 0, 480).is_empty());
     }
 }

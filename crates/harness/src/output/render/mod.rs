@@ -12,8 +12,10 @@
 //!   lines against the swept parameter when the report is a sweep), scaling curves with fitted
 //!   exponents and theory slopes (when the scenes grow), break-even per scene, validation
 //!   classes; one colour per structure throughout;
-//! * `images/*.png` — per scene and structure: traversal-cost heatmap (one colour scale per
-//!   scene), shaded render, disagreement mask; one legend colour bar.
+//! * `images/*.png` — per scene: the reference's shaded render and each counting structure's
+//!   traversal-cost heatmap on one colour scale, at the full picture size when `raybench run`
+//!   drew them (copied from beside the report), else drawn from the small planes in
+//!   `report.json`; disagreement masks only for structures that disagree.
 //!
 //! The pages are static; a few lines of inline script sort the tables, and every page reads
 //! the same without it. Every file is written atomically (a temporary file, then a rename).
@@ -77,14 +79,22 @@ pub(crate) struct ChartFile {
     pub scene: Option<String>,
 }
 
-/// Pictures of one scene.
+/// Pictures of one scene, as a page shows them (paths relative to the page's directory).
 #[derive(Clone, Debug)]
 pub(crate) struct ScenePictures {
     pub scene: String,
-    pub max_cost: u16,
-    pub downsample: u32,
-    /// (structure, heatmap file if counted, render file, mask file)
-    pub rows: Vec<(String, Option<String>, String, String)>,
+    /// Pixel size of the picture files.
+    pub width: u32,
+    pub height: u32,
+    /// The top of the scene's colour scale: the largest cost per pixel of any structure.
+    pub max_cost: u64,
+    /// Why the small planes of report.json were drawn instead of full-size files; `None` when
+    /// the files are full size.
+    pub fallback: Option<String>,
+    /// The structure whose hits are shaded, and the render file.
+    pub render: Option<(String, String)>,
+    /// Per structure: its heatmap (absent: not counted) and mask (absent: agrees everywhere).
+    pub structures: Vec<crate::pipeline::picture::StructurePicture>,
 }
 
 pub fn render(report: &Report, dir: &Path) -> Result<Rendered> {

@@ -47,40 +47,84 @@ pub fn heatmap_pixels(img: &PrimaryImage, max: u16) -> Result<Option<Vec<[u8; 3]
 
 /// `ln(1 + c) / ln(1 + max)`: 0 for no work, 1 at the scene's maximum.
 pub fn log_scale(c: u16, max: u16) -> f64 {
+    log_position(c.into(), max.into())
+}
+
+/// Where cost `c` sits on a logarithmic scale whose top is `max`: `ln(1 + c) / ln(1 + max)`.
+pub fn log_position(c: u64, max: u64) -> f64 {
     (1.0 + c as f64).ln() / (1.0 + max.max(1) as f64).ln()
 }
 
-pub fn shade_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
-    let shade = img.shade_values().map_err(|e| anyhow!(e))?;
-    Ok(shade
+/// Heatmap pixels from costs already on a quantized logarithmic scale (`round(k·ln(1 + c))`),
+/// `top` being the scene maximum's step: the same colours as [`log_scale`], from half the
+/// memory of exact costs.
+pub fn heat_rgb(steps: &[u16], top: u16) -> Vec<[u8; 3]> {
+    let top = f64::from(top.max(1));
+    steps.iter().map(|&q| viridis(f64::from(q) / top)).collect()
+}
+
+/// Miss: dark blue-grey background; hit: grey from the shade (1..=255).
+pub fn render_rgb(shade: &[u8]) -> Vec<[u8; 3]> {
+    shade
         .iter()
         .map(|&s| {
             if s == 0 {
-                [34, 40, 49] // miss: dark blue-grey background
+                [34, 40, 49]
             } else {
                 let v = 40 + (s as u32 * 215 / 255) as u8;
                 [v, v, v]
             }
         })
-        .collect())
+        .collect()
 }
 
-/// Agreeing pixels as a dim version of the render, explained differences amber, mismatches red.
-pub fn disagree_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
-    let shade = img.shade_values().map_err(|e| anyhow!(e))?;
-    let d = img.disagree_values().map_err(|e| anyhow!(e))?;
-    Ok(shade
+/// Agreeing pixels as a dim version of the render, explained differences amber, mismatches red;
+/// each disagreeing pixel also gets a half-tone halo [`HALO`] pixels wide per 640 of width, so
+/// that a single one can be found in a picture shown smaller than its file. The pixel itself
+/// keeps the full colour.
+pub fn mask_rgb(shade: &[u8], levels: &[u8], width: usize) -> Vec<[u8; 3]> {
+    let colour = |d: u8| if d == 1 { [255, 191, 0] } else { [230, 20, 20] };
+    let mut out: Vec<[u8; 3]> = shade
         .iter()
-        .zip(&d)
+        .zip(levels)
         .map(|(&s, &d)| match d {
             0 => {
                 let v = 20 + (s as u32 * 60 / 255) as u8;
                 [v, v, v]
             }
-            1 => [255, 191, 0],
-            _ => [230, 20, 20],
+            d => colour(d),
         })
-        .collect())
+        .collect();
+    let width = width.max(1);
+    let height = levels.len() / width;
+    let r = (HALO * width).div_ceil(640);
+    for (i, &d) in levels.iter().enumerate().filter(|(_, d)| **d > 0) {
+        let (x, y) = (i % width, i / width);
+        for yy in y.saturating_sub(r)..(y + r + 1).min(height) {
+            for xx in x.saturating_sub(r)..(x + r + 1).min(width) {
+                let j = yy * width + xx;
+                if levels[j] == 0 {
+                    let [a, b, c] = colour(d);
+                    let [p, q, s] = out[j];
+                    out[j] = [a / 2 + p / 2, b / 2 + q / 2, c / 2 + s / 2];
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Halo radius of a disagreeing pixel in a 640-wide mask.
+pub const HALO: usize = 4;
+
+pub fn shade_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
+    Ok(render_rgb(&img.shade_values().map_err(|e| anyhow!(e))?))
+}
+
+pub fn disagree_pixels(img: &PrimaryImage) -> Result<Vec<[u8; 3]>> {
+    let shade = img.shade_values().map_err(|e| anyhow!(e))?;
+    let d = img.disagree_values().map_err(|e| anyhow!(e))?;
+    Ok(mask_rgb(&shade, &d, img.width as usize))
 }
 
 /// The largest cost of any structure's image of a scene: one colour scale per scene.
@@ -92,15 +136,6 @@ pub fn shared_max(images: &[&PrimaryImage]) -> u16 {
         .max()
         .unwrap_or(1)
         .max(1)
-}
-
-/// A horizontal colour bar, 256 × 16, low on the left.
-pub fn write_legend(out: &Path) -> Result<()> {
-    let (w, h) = (256u32, 16u32);
-    let pixels: Vec<[u8; 3]> = (0..h)
-        .flat_map(|_| (0..w).map(|x| viridis(x as f64 / (w - 1) as f64)))
-        .collect();
-    write_png(&pixels, w, h, out)
 }
 
 pub fn write(pixels: &[[u8; 3]], img: &PrimaryImage, out: &Path) -> Result<()> {

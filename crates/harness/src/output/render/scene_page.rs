@@ -59,8 +59,6 @@ pub(crate) fn scene_page(site: &Site, scene: &str) -> String {
         }
     }
     if let Some(p) = site.pictures.iter().find(|p| p.scene == scene) {
-        // The picture section's one-scene form, `scene_pictures(&mut s, p)`, takes this
-        // call's place once picture_section.rs offers it.
         super::picture_section::pictures_section(&mut s, std::slice::from_ref(p));
     }
     s.push_str("<h2 id=\"agreement\">Agreement</h2>\n");
