@@ -5,6 +5,7 @@
 use super::ScenePictures;
 use super::page::escape;
 use super::pictures::{log_position, viridis};
+use super::ticks::thousands;
 use std::fmt::Write as _;
 
 /// Display width of a picture on the page (pixels); the link opens the file at full size.
@@ -241,19 +242,6 @@ fn ticks(max: u64) -> Vec<(u64, f64)> {
     out
 }
 
-/// `12345678` → `12,345,678`.
-fn thousands(v: u64) -> String {
-    let digits = v.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -268,13 +256,5 @@ mod tests {
         assert_eq!(*xs.last().unwrap(), BAR_X + BAR_W);
         assert_eq!(ticks(0).iter().map(|t| t.0).collect::<Vec<_>>(), [0, 1]);
         assert_eq!(ticks(u64::MAX).last().unwrap().0, u64::MAX);
-    }
-
-    #[test]
-    fn numbers_get_thousands_separators() {
-        assert_eq!(thousands(0), "0");
-        assert_eq!(thousands(999), "999");
-        assert_eq!(thousands(1000), "1,000");
-        assert_eq!(thousands(12_345_678), "12,345,678");
     }
 }

@@ -23,8 +23,8 @@ pub(crate) fn summary_page(site: &Site) -> String {
         s,
         "<p class=\"{}\">{} mismatches in {} checked rays.",
         if mismatches > 0 { "bad" } else { "note" },
-        mismatches,
-        checked
+        super::ticks::thousands(mismatches),
+        super::ticks::thousands(checked)
     );
     if !report.errors.is_empty() {
         let _ = write!(

@@ -97,9 +97,22 @@ fn place_point(digits: &str, exp: i32) -> String {
     }
 }
 
+/// `12345678` → `12,345,678`.
+pub(crate) fn thousands(v: u64) -> String {
+    let digits = v.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{axis_ticks, tick_label};
+    use super::{axis_ticks, thousands, tick_label};
 
     fn labels(lo: f64, hi: f64, log: bool) -> Vec<String> {
         axis_ticks(lo, hi, log)
@@ -138,6 +151,14 @@ mod tests {
         assert!(axis_ticks(0.0, 1.0, true).is_empty());
         assert!(axis_ticks(0.0, 5e-324, false).is_empty());
         assert!(axis_ticks(1.0, 1.0 + f64::EPSILON, false).len() <= 9);
+    }
+
+    #[test]
+    fn whole_numbers_group_their_thousands() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(1000), "1,000");
+        assert_eq!(thousands(12_345_678), "12,345,678");
     }
 
     #[test]
