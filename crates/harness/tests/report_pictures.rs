@@ -108,7 +108,7 @@ fn a_run_writes_full_size_pictures_one_render_per_scene() {
         2
     );
 
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let html = scene_pages(&out);
     assert_eq!(html.matches("class=\"picture\"").count(), listed.len());
     for f in &listed {
         assert!(
@@ -212,7 +212,7 @@ fn a_moved_report_falls_back_to_small_planes_and_says_so() {
     for f in &listed {
         assert_eq!(png_size(&copy.join(f)), (96, 72), "{f}");
     }
-    let html = std::fs::read_to_string(copy.join("index.html")).unwrap();
+    let html = scene_pages(&copy);
     assert!(!html.contains("Small pictures"));
     assert_eq!(html.matches("class=\"picture\"").count(), listed.len());
 
@@ -231,7 +231,7 @@ fn a_moved_report_falls_back_to_small_planes_and_says_so() {
     let moved_arg = moved.join("report.json").display().to_string();
     let (code, _, stderr) = invoke(&["report", &moved_arg, "--out", &page.display().to_string()]);
     assert_eq!(code, 0, "{stderr}");
-    let html = std::fs::read_to_string(page.join("index.html")).unwrap();
+    let html = scene_pages(&page);
     assert_eq!(html.matches("<b>Small pictures:</b>").count(), 2, "{html}");
     assert!(html.contains("the full-size files were not found beside the report"));
     assert!(!html.contains("class=\"picture\""));
@@ -256,8 +256,24 @@ fn a_moved_report_falls_back_to_small_planes_and_says_so() {
     let out = dir.join("evil-page");
     let (code, _, stderr) = invoke(&["report", &evil_arg, "--out", &out.display().to_string()]);
     assert_eq!(code, 0, "{stderr}");
-    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let html = scene_pages(&out);
     assert!(html.contains("unusable picture file"), "{html}");
     assert!(!out.join("report.json").exists());
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Every scene page of a drawing, one after the other: the pictures live there, not on the
+/// summary.
+fn scene_pages(dir: &std::path::Path) -> String {
+    let mut names: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("scene-") && n.ends_with(".html"))
+        .collect();
+    names.sort();
+    assert!(!names.is_empty(), "no scene page in {}", dir.display());
+    names
+        .iter()
+        .map(|n| std::fs::read_to_string(dir.join(n)).unwrap())
+        .collect()
 }
