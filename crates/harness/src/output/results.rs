@@ -231,6 +231,7 @@ pub fn results_page(report: &Report, report_link: &str) -> String {
         run.reference, run.reference
     );
     s.push_str(&headline(report));
+    claims_table(&mut s, report);
     scene_tables(&mut s, report);
     sah_table(&mut s, report);
     if !report.notes.is_empty() || !report.errors.is_empty() {
@@ -243,6 +244,29 @@ pub fn results_page(report: &Report, report_link: &str) -> String {
         }
     }
     s
+}
+
+/// The claims this run decided (none listed when it measured none): claim, figures, verdict.
+fn claims_table(s: &mut String, report: &Report) {
+    use crate::report::claims::{Verdict, of_report};
+    let claims = of_report(report);
+    if claims.iter().all(|c| c.verdict == Verdict::NotMeasured) {
+        return;
+    }
+    s.push_str(
+        "\n## Claims\n\nEach decided on this run's data by its rule (see \
+         [docs/claims.md](../claims.md)).\n\n| claim | figures | verdict |\n|---|---|---|\n",
+    );
+    let cell = |t: &str| t.replace('|', "\\|");
+    for c in &claims {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} |",
+            cell(&c.statement),
+            cell(&c.figures.join("; ")),
+            c.verdict.text()
+        );
+    }
 }
 
 /// Per scene: build ms (ratio), memory MB, and throughput per workload with its ratio.
