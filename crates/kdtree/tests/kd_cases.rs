@@ -274,7 +274,11 @@ fn counters_show_early_exit_and_mailbox_skips() {
         let h = kd.intersect_counted(r, &mut c);
         assert_eq!(h.map(|h| h.prim), bf.intersect(r).map(|h| h.prim));
         no_mb.intersect_counted(r, &mut c_no);
-        assert_eq!(exhaustive.intersect_counted(r, &mut c_all), h, "same answer");
+        assert_eq!(
+            exhaustive.intersect_counted(r, &mut c_all),
+            h,
+            "same answer"
+        );
     }
     // Without early exit the walk goes on through the back of the sphere: at least twice the
     // leaves (front and back surfaces), every one of which early exit skipped.

@@ -5,6 +5,7 @@
 //! agreement); one table per scene; the SAH cost of every structure that has one.
 
 use super::agreement::class_counts;
+use super::render::names::structure_names;
 use super::summary::sig;
 use crate::report::run::{Report, ResultEntry, is_point_workload, throughput_unit};
 use raybench_accel::classify::VerdictCounts;
@@ -36,8 +37,22 @@ pub struct HeadlineRow {
     pub scenes: usize,
 }
 
-/// The headline rows: every structure of the run but the reference, in the run's order.
-pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
+/// One structure's ratios to the reference, scene by scene: `(ratio, scene)` for each scene
+/// that has the ratio. The headline takes their geometric means; the page adds their spread.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneRatios {
+    pub structure: String,
+    /// Throughput relative to the reference, one list per workload of the run.
+    pub workloads: Vec<Vec<(f64, String)>>,
+    pub build: Vec<(f64, String)>,
+    /// Bytes held relative to the reference's on the same scene.
+    pub memory: Vec<(f64, String)>,
+    /// Scenes the structure has a result on.
+    pub scenes: usize,
+}
+
+/// Every structure of the run but the reference, in the run's order, with its ratios.
+pub fn scene_ratios(report: &Report) -> Vec<SceneRatios> {
     let reference = &report.run.reference;
     let reference_on = |scene: &str| {
         report
@@ -45,7 +60,7 @@ pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
             .iter()
             .find(|r| r.scene == scene && &r.structure == reference)
     };
-    structures(report)
+    structure_names(report)
         .into_iter()
         .filter(|s| s != reference)
         .map(|structure| {
@@ -54,25 +69,31 @@ pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
                 .iter()
                 .filter(|r| r.structure == structure)
                 .collect();
+            let per_scene = |f: &dyn Fn(&ResultEntry) -> Option<f64>| -> Vec<(f64, String)> {
+                entries
+                    .iter()
+                    .filter_map(|r| Some((f(r)?, r.scene.clone())))
+                    .collect()
+            };
             let workloads = report
                 .run
                 .workloads
                 .iter()
                 .map(|wl| {
-                    geometric_mean(entries.iter().filter_map(|r| {
+                    per_scene(&|r: &ResultEntry| {
                         r.workloads
                             .iter()
-                            .find(|w| &w.workload == wl)
-                            .and_then(|w| w.speedup_vs_reference)
-                    }))
+                            .find(|w| &w.workload == wl)?
+                            .speedup_vs_reference
+                    })
                 })
                 .collect();
-            let build = geometric_mean(entries.iter().filter_map(|r| r.build_ratio_to_reference));
-            let memory = geometric_mean(entries.iter().filter_map(|r| {
+            let build = per_scene(&|r: &ResultEntry| r.build_ratio_to_reference);
+            let memory = per_scene(&|r: &ResultEntry| {
                 let base = reference_on(&r.scene)?.memory_bytes;
                 (base > 0).then(|| r.memory_bytes as f64 / base as f64)
-            }));
-            HeadlineRow {
+            });
+            SceneRatios {
                 structure,
                 workloads,
                 build,
@@ -83,21 +104,19 @@ pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
         .collect()
 }
 
-/// Structures in the run's order, then any other that has results.
-fn structures(report: &Report) -> Vec<String> {
-    let mut names: Vec<String> = report
-        .run
-        .structures
-        .iter()
-        .filter(|s| report.results.iter().any(|r| &r.structure == *s))
-        .cloned()
-        .collect();
-    for r in &report.results {
-        if !names.contains(&r.structure) {
-            names.push(r.structure.clone());
-        }
-    }
-    names
+/// The headline rows: every structure of the run but the reference, in the run's order.
+pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
+    let mean = |v: &[(f64, String)]| geometric_mean(v.iter().map(|(x, _)| *x));
+    scene_ratios(report)
+        .into_iter()
+        .map(|r| HeadlineRow {
+            workloads: r.workloads.iter().map(|w| mean(w)).collect(),
+            build: mean(&r.build),
+            memory: mean(&r.memory),
+            structure: r.structure,
+            scenes: r.scenes,
+        })
+        .collect()
 }
 
 /// Scenes in the order the report lists them, then any other that has results.
@@ -274,7 +293,7 @@ fn scene_tables(s: &mut String, report: &Report) {
     let workloads = &report.run.workloads;
     s.push_str("\n## Scenes\n\nBuild time (median) and throughput (median) with the ratio to the reference in parentheses.\n");
     for scene in scenes(report) {
-        let entries: Vec<&ResultEntry> = structures(report)
+        let entries: Vec<&ResultEntry> = structure_names(report)
             .iter()
             .filter_map(|st| {
                 report
@@ -327,7 +346,7 @@ fn scene_tables(s: &mut String, report: &Report) {
 
 /// SAH cost per scene × structure, for the structures that have one.
 fn sah_table(s: &mut String, report: &Report) {
-    let with_sah: Vec<String> = structures(report)
+    let with_sah: Vec<String> = structure_names(report)
         .into_iter()
         .filter(|st| {
             report

@@ -3,10 +3,9 @@
 //! over scenes from 0.5 to 2.0 is a different answer from one where every scene is near 1.0,
 //! and the range says so in the units of the mean; its ends name their scenes on hover.
 
-use super::names::structure_names;
 use super::page::escape;
-use crate::output::results::{geometric_mean, ratio_text};
-use crate::report::run::{Report, ResultEntry};
+use crate::output::results::{geometric_mean, ratio_text, scene_ratios};
+use crate::report::run::Report;
 use std::fmt::Write as _;
 
 /// A geometric mean over scenes and the scenes with the lowest and the highest ratio.
@@ -78,51 +77,14 @@ pub(crate) struct Row {
 
 /// Every structure but the reference, in the run's order.
 pub(crate) fn rows(report: &Report) -> Vec<Row> {
-    let reference = &report.run.reference;
-    let reference_bytes = |scene: &str| {
-        report
-            .results
-            .iter()
-            .find(|r| r.scene == scene && &r.structure == reference)
-            .map(|r| r.memory_bytes)
-            .filter(|&b| b > 0)
-    };
-    structure_names(report)
+    scene_ratios(report)
         .into_iter()
-        .filter(|s| s != reference)
-        .map(|structure| {
-            let entries: Vec<&ResultEntry> = report
-                .results
-                .iter()
-                .filter(|r| r.structure == structure)
-                .collect();
-            let workloads = report
-                .run
-                .workloads
-                .iter()
-                .map(|wl| {
-                    Spread::of(entries.iter().filter_map(|r| {
-                        let w = r.workloads.iter().find(|w| &w.workload == wl)?;
-                        Some((w.speedup_vs_reference?, r.scene.clone()))
-                    }))
-                })
-                .collect();
-            let build = Spread::of(
-                entries
-                    .iter()
-                    .filter_map(|r| Some((r.build_ratio_to_reference?, r.scene.clone()))),
-            );
-            let memory = Spread::of(entries.iter().filter_map(|r| {
-                let base = reference_bytes(&r.scene)?;
-                Some((r.memory_bytes as f64 / base as f64, r.scene.clone()))
-            }));
-            Row {
-                structure,
-                workloads,
-                build,
-                memory,
-                scenes: entries.len(),
-            }
+        .map(|r| Row {
+            workloads: r.workloads.into_iter().map(Spread::of).collect(),
+            build: Spread::of(r.build),
+            memory: Spread::of(r.memory),
+            structure: r.structure,
+            scenes: r.scenes,
         })
         .collect()
 }
