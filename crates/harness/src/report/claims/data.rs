@@ -171,13 +171,3 @@ pub(super) fn number(v: f64) -> String {
         format!("{v:.3}")
     }
 }
-
-/// The geometric mean of positive finite values; `None` when there are none.
-pub(super) fn geomean(values: &[f64]) -> Option<f64> {
-    let v: Vec<f64> = values
-        .iter()
-        .copied()
-        .filter(|x| x.is_finite() && *x > 0.0)
-        .collect();
-    (!v.is_empty()).then(|| (v.iter().map(|x| x.ln()).sum::<f64>() / v.len() as f64).exp())
-}

@@ -2,8 +2,9 @@
 //! part of a huge scene (the teapot in a stadium), and its resolution has a best value, with
 //! too few cells and too many both slower.
 
-use super::data::{Data, Measure, geomean, number};
+use super::data::{Data, Measure, number};
 use super::{Claim, ClaimChart, Evaluated};
+use crate::output::results::geometric_mean;
 
 /// The teapot-in-stadium scenes that differ only in `size_ratio`: (ratio, scene), largest
 /// ratio first. Of several such groups (other parameters or views), the one with the most
@@ -159,7 +160,7 @@ pub(super) fn best_resolution(d: Data) -> Evaluated {
             .zip(time("grid"))
             .filter_map(|(a, b)| Some(a.as_ref()? / b?))
             .collect();
-        geomean(&ratios)
+        geometric_mean(ratios)
     };
     let (Some(coarse), Some(fine)) = (slower("grid-coarse"), slower("grid-fine")) else {
         return c.lacks("throughputs of the three grids on one scene");

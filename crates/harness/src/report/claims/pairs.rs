@@ -3,8 +3,9 @@
 //! against fixed child order (the same tree), the k-d tree with and without early exit (the
 //! same tree).
 
-use super::data::{Data, Measure, geomean, number};
+use super::data::{Data, Measure, number};
 use super::{Claim, ClaimChart, Evaluated};
+use crate::output::results::geometric_mean;
 
 /// `a / b` of `m` per scene, and its geometric mean.
 fn ratios(
@@ -21,7 +22,7 @@ fn ratios(
             (y > 0.0).then_some(x / y)
         })
         .collect();
-    let mean = geomean(&per.iter().flatten().copied().collect::<Vec<_>>());
+    let mean = geometric_mean(per.iter().flatten().copied());
     (per, mean)
 }
 
@@ -59,7 +60,7 @@ pub(super) fn binned_sah(d: Data) -> Evaluated {
     let sah = per_scene(&|r| r.build_stats.sah_cost);
     let build = per_scene(&|r| Some(r.build.median_ms));
     let (time, time_mean) = ratios(d, &scenes, (pair[0], pair[1]), &wl, Measure::NsPerQuery);
-    let mean = |v: &[Option<f64>]| geomean(&v.iter().flatten().copied().collect::<Vec<_>>());
+    let mean = |v: &[Option<f64>]| geometric_mean(v.iter().flatten().copied());
     let (Some(sah_mean), Some(build_mean), Some(time_mean)) = (mean(&sah), mean(&build), time_mean)
     else {
         return c.lacks("SAH costs, builds and throughputs of both on one scene");
