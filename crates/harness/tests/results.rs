@@ -177,5 +177,73 @@ fn the_page_has_the_headline_scene_and_sah_tables_and_links_the_report() {
         !only.contains("## ") && !only.contains("report.json"),
         "{only}"
     );
+
+    // The headline again against another structure of the run: the reference gets a row, the
+    // ratio of the two medians per scene, so embree-medium's is the reciprocal of bvh-binned's.
+    let page = raybench(&[
+        "results",
+        path.to_str().unwrap(),
+        "--also-against",
+        "bvh-binned",
+    ]);
+    let against =
+        &page[page.find("## Against `bvh-binned`").unwrap()..page.find("## Scenes").unwrap()];
+    let inverse: Vec<f64> = ["primary", "random", "points-near"]
+        .iter()
+        .map(|wl| {
+            let ratios: Vec<f64> = report
+                .results
+                .iter()
+                .filter(|r| r.structure == "bvh-binned")
+                .map(|r| {
+                    let w = r.workloads.iter().find(|w| &w.workload == wl).unwrap();
+                    1.0 / w.speedup_vs_reference.unwrap()
+                })
+                .collect();
+            geometric_mean(&ratios)
+        })
+        .collect();
+    let row = format!(
+        "| embree-medium | {:.2} | {:.2} | {:.2} |",
+        inverse[0], inverse[1], inverse[2]
+    );
+    assert!(against.contains(&row), "{row}\n{against}");
+    assert!(!against.contains("| bvh-binned |"), "{against}");
+
+    // Work per ray: bvh-binned counts its work, Embree does not.
+    let work = &page[page.find("## Work per ray").unwrap()..];
+    let counted = report
+        .results
+        .iter()
+        .find(|r| r.scene == SCENES[0] && r.structure == "bvh-binned")
+        .unwrap();
+    let w = raybench_harness::output::work_per_ray::work_per_ray(counted, "random").unwrap();
+    let c = counted.workloads[1].counters_per_query.as_ref().unwrap();
+    assert_eq!((w.nodes, w.prim_tests), (c.nodes, c.prim_tests));
+    let node_bytes = counted.memory.nodes as f64
+        / (counted.build_stats.nodes - counted.build_stats.leaves) as f64;
+    assert!(
+        (node_bytes - 64.0).abs() < 1e-9,
+        "binary nodes are 64 bytes: {node_bytes}"
+    );
+    assert!(w.bytes.unwrap() > c.nodes * 64.0, "{w:?}");
+    assert!(work.contains("| structure | primary | random |"), "{work}");
+    assert!(work.contains("| bvh-binned | "), "{work}");
+    assert!(!work.contains("| embree-medium |"), "{work}");
+
+    let out = Command::new(env!("CARGO_BIN_EXE_raybench"))
+        .args([
+            "results",
+            path.to_str().unwrap(),
+            "--also-against",
+            "kd-sah",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--also-against kd-sah"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&root).unwrap();
 }

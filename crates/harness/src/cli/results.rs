@@ -24,10 +24,22 @@ pub struct ResultsArgs {
     /// Only the headline table and the agreement sentence (to paste into the README).
     #[arg(long)]
     headline_only: bool,
+    /// Repeat the headline relative to this structure of the run too (e.g. embree-high);
+    /// comma-separated or repeated.
+    #[arg(long, value_delimiter = ',')]
+    also_against: Vec<String>,
 }
 
 pub fn run(args: ResultsArgs) -> Result<ExitCode> {
     let report = Report::read(&args.report)?;
+    for other in &args.also_against {
+        if !report.results.iter().any(|r| &r.structure == other) {
+            anyhow::bail!(
+                "--also-against {other}: {} has no results of '{other}'",
+                args.report.display()
+            );
+        }
+    }
     let page_dir = match args.out.as_deref().and_then(Path::parent) {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -43,7 +55,7 @@ pub fn run(args: ResultsArgs) -> Result<ExitCode> {
             Some(link) => link,
             None => relative_link(&args.report, &page_dir)?,
         };
-        results_page(&report, &link)
+        results_page(&report, &link, &args.also_against)
     };
     match &args.out {
         Some(out) => {

@@ -12,3 +12,4 @@ pub mod results;
 pub mod summary;
 pub mod verify_table;
 pub mod watertight_table;
+pub mod work_per_ray;

@@ -2,7 +2,8 @@
 //! `docs/results/<date>.md` beside the report it was made from. The page is generated, never
 //! typed by hand: a heading naming the run and linking its report; the headline (per structure,
 //! the geometric mean over scenes of each ratio to the reference, and one sentence on
-//! agreement); one table per scene; the SAH cost of every structure that has one.
+//! agreement), again against other structures of the run when asked; one table per scene; the
+//! SAH cost of every structure that has one; the work per ray of every structure that counts it.
 
 use super::agreement::class_counts;
 use super::render::names::structure_names;
@@ -53,13 +54,20 @@ pub struct SceneRatios {
 
 /// Every structure of the run but the reference, in the run's order, with its ratios.
 pub fn scene_ratios(report: &Report) -> Vec<SceneRatios> {
-    let reference = &report.run.reference;
+    scene_ratios_to(report, &report.run.reference)
+}
+
+/// Every structure of the run but `reference`, with its ratios to `reference`'s medians on
+/// each scene (the run's reference, or another structure of the same run such as embree-high:
+/// the ratios are as fair, from the same run).
+pub fn scene_ratios_to(report: &Report, reference: &str) -> Vec<SceneRatios> {
     let reference_on = |scene: &str| {
         report
             .results
             .iter()
-            .find(|r| r.scene == scene && &r.structure == reference)
+            .find(|r| r.scene == scene && r.structure == reference)
     };
+    let ratio = |x: f64, base: f64| (base > 0.0).then(|| x / base);
     structure_names(report)
         .into_iter()
         .filter(|s| s != reference)
@@ -69,29 +77,36 @@ pub fn scene_ratios(report: &Report) -> Vec<SceneRatios> {
                 .iter()
                 .filter(|r| r.structure == structure)
                 .collect();
-            let per_scene = |f: &dyn Fn(&ResultEntry) -> Option<f64>| -> Vec<(f64, String)> {
+            let per_scene = |f: &dyn Fn(&ResultEntry, &ResultEntry) -> Option<f64>| {
                 entries
                     .iter()
-                    .filter_map(|r| Some((f(r)?, r.scene.clone())))
-                    .collect()
+                    .filter_map(|r| Some((f(r, reference_on(&r.scene)?)?, r.scene.clone())))
+                    .collect::<Vec<(f64, String)>>()
             };
             let workloads = report
                 .run
                 .workloads
                 .iter()
                 .map(|wl| {
-                    per_scene(&|r: &ResultEntry| {
-                        r.workloads
-                            .iter()
-                            .find(|w| &w.workload == wl)?
-                            .speedup_vs_reference
+                    per_scene(&|r: &ResultEntry, base: &ResultEntry| {
+                        let of = |e: &ResultEntry| {
+                            Some(
+                                e.workloads
+                                    .iter()
+                                    .find(|w| &w.workload == wl)?
+                                    .mqueries_per_s
+                                    .median,
+                            )
+                        };
+                        ratio(of(r)?, of(base)?)
                     })
                 })
                 .collect();
-            let build = per_scene(&|r: &ResultEntry| r.build_ratio_to_reference);
-            let memory = per_scene(&|r: &ResultEntry| {
-                let base = reference_on(&r.scene)?.memory_bytes;
-                (base > 0).then(|| r.memory_bytes as f64 / base as f64)
+            let build = per_scene(&|r: &ResultEntry, base: &ResultEntry| {
+                ratio(r.build.median_ms, base.build.median_ms)
+            });
+            let memory = per_scene(&|r: &ResultEntry, base: &ResultEntry| {
+                ratio(r.memory_bytes as f64, base.memory_bytes as f64)
             });
             SceneRatios {
                 structure,
@@ -106,8 +121,13 @@ pub fn scene_ratios(report: &Report) -> Vec<SceneRatios> {
 
 /// The headline rows: every structure of the run but the reference, in the run's order.
 pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
+    headline_rows_to(report, &report.run.reference)
+}
+
+/// [`headline_rows`] relative to `reference`, another structure of the same run.
+pub fn headline_rows_to(report: &Report, reference: &str) -> Vec<HeadlineRow> {
     let mean = |v: &[(f64, String)]| geometric_mean(v.iter().map(|(x, _)| *x));
-    scene_ratios(report)
+    scene_ratios_to(report, reference)
         .into_iter()
         .map(|r| HeadlineRow {
             workloads: r.workloads.iter().map(|w| mean(w)).collect(),
@@ -148,6 +168,13 @@ pub(crate) fn cell(x: Option<f64>) -> String {
 /// The headline table and the agreement sentence (what `--headline-only` prints, for pasting
 /// into the README).
 pub fn headline(report: &Report) -> String {
+    let mut s = headline_table(report, &report.run.reference);
+    let _ = writeln!(s, "\n{}", agreement_line(report));
+    s
+}
+
+/// The headline's table (and which structures ran on fewer scenes) relative to `reference`.
+fn headline_table(report: &Report, reference: &str) -> String {
     let mut s = String::new();
     let workloads = &report.run.workloads;
     s.push_str("| structure |");
@@ -157,7 +184,7 @@ pub fn headline(report: &Report) -> String {
     s.push_str(" build | memory |\n|---|");
     s.push_str(&"---:|".repeat(workloads.len() + 2));
     s.push('\n');
-    let rows = headline_rows(report);
+    let rows = headline_rows_to(report, reference);
     for row in &rows {
         let _ = write!(s, "| {} |", row.structure);
         for w in &row.workloads {
@@ -178,7 +205,6 @@ pub fn headline(report: &Report) -> String {
             fewer.join(", ")
         );
     }
-    let _ = writeln!(s, "\n{}", agreement_line(report));
     s
 }
 
@@ -212,8 +238,10 @@ fn agreement_line(report: &Report) -> String {
     line
 }
 
-/// The whole page; `report_link` is where the heading's link to the report points.
-pub fn results_page(report: &Report, report_link: &str) -> String {
+/// The whole page; `report_link` is where the heading's link to the report points, and
+/// `also_against` names other structures of the run the headline is repeated against (say
+/// embree-high beside the reference embree-medium).
+pub fn results_page(report: &Report, report_link: &str, also_against: &[String]) -> String {
     let env = &report.header.environment;
     let run = &report.run;
     let date = env.timestamp.get(..10).unwrap_or(&env.timestamp);
@@ -250,9 +278,18 @@ pub fn results_page(report: &Report, report_link: &str) -> String {
         run.reference, run.reference
     );
     s.push_str(&headline(report));
+    for other in also_against {
+        let _ = writeln!(
+            s,
+            "\n## Against `{other}`\n\nThe headline's geometric means relative to `{other}` \
+             in the same run (its medians on each scene).\n"
+        );
+        s.push_str(&headline_table(report, other));
+    }
     claims_table(&mut s, report);
     scene_tables(&mut s, report);
     sah_table(&mut s, report);
+    super::work_per_ray::work_section(&mut s, report);
     if !report.notes.is_empty() || !report.errors.is_empty() {
         s.push_str("\n## Notes\n\n");
         for n in &report.notes {
