@@ -106,18 +106,30 @@ fn run(tree: &mut Tree, knobs: &Reinsertion, stats: &mut ReinsertStats) {
     let batch = ((tree.len() as f64 * knobs.batch_fraction as f64).ceil() as usize)
         .clamp(1, tree.len() - 1);
     let mut marks = Marks::new(tree.len());
+    // Nodes whose search found no better place: later rounds go on down the ranking instead
+    // of searching them again (the tree around them changes little).
+    let mut settled = vec![false; tree.len()];
     let mut area = interior_area(tree);
     let mut candidates: Vec<(f64, u32)> = Vec::with_capacity(tree.len());
     for _ in 0..knobs.max_rounds {
+        choose(tree, &settled, batch, &mut candidates);
+        if candidates.is_empty() {
+            break;
+        }
         stats.rounds += 1;
-        choose(tree, batch, &mut candidates);
         let t: &Tree = tree;
-        let mut moves: Vec<Move> = candidates
+        let found: Vec<Option<Move>> = candidates
             .par_iter()
             .with_min_len(16)
             .map_init(Vec::new, |stack, &(_, x)| best_move(t, x, stack))
-            .flatten()
             .collect();
+        let mut moves = Vec::with_capacity(found.len());
+        for (m, &(_, x)) in found.into_iter().zip(&candidates) {
+            match m {
+                Some(m) => moves.push(m),
+                None => settled[x as usize] = true,
+            }
+        }
         moves.sort_unstable_by(|a, b| b.gain.total_cmp(&a.gain).then(a.from.cmp(&b.from)));
         let mut gained = 0.0;
         // Gains below this are rounding, not improvement.
@@ -140,12 +152,12 @@ fn run(tree: &mut Tree, knobs: &Reinsertion, stats: &mut ReinsertStats) {
     }
 }
 
-/// The `batch` nodes with the largest boxes, the root excluded (ties by id).
-fn choose(t: &Tree, batch: usize, out: &mut Vec<(f64, u32)>) {
+/// The `batch` unsettled nodes with the largest boxes, the root excluded (ties by id).
+fn choose(t: &Tree, settled: &[bool], batch: usize, out: &mut Vec<(f64, u32)>) {
     out.clear();
     out.extend(
         (0..t.len() as u32)
-            .filter(|&n| n != t.root)
+            .filter(|&n| n != t.root && !settled[n as usize])
             .map(|n| (t.area(n), n)),
     );
     let larger_first = |a: &(f64, u32), b: &(f64, u32)| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1));
@@ -155,3 +167,6 @@ fn choose(t: &Tree, batch: usize, out: &mut Vec<(f64, u32)>) {
     }
     out.sort_unstable_by(larger_first);
 }
+
+#[cfg(test)]
+mod tests;
