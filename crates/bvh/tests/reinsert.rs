@@ -115,16 +115,25 @@ fn the_sah_cost_never_rises() {
 }
 
 /// A tree built badly on purpose (object median) gets strictly cheaper, with moves made, on
-/// every scene but the uniform soup (where the largest 1 % of boxes, near the root, have no
-/// better place: 0 moves); so does the 8-wide tree's binned tree on the teapot in a stadium.
+/// every scene, when the rounds go on down the ranking of boxes whatever a round gains, 10 %
+/// of the nodes a round (the defaults stop after a round that gains under 0.1 %, which on the
+/// median trees of the sphere and the soup is the first: the largest boxes, near the root,
+/// have no better place, and on the soup none of the largest 8 % has);
+/// the 8-wide tree's binned tree of the teapot in a stadium gets cheaper with the defaults.
 #[test]
 fn a_poor_tree_gets_strictly_cheaper() {
-    for (spec, seed) in SCENES
-        .into_iter()
-        .filter(|(spec, _)| !spec.starts_with("soup"))
-    {
+    let p = BvhParams {
+        reinsertion: Some(Reinsertion {
+            batch_fraction: 0.1,
+            min_round_gain: 0.0,
+            max_rounds: 8,
+        }),
+        ..BvhParams::median()
+    };
+    for (spec, seed) in SCENES {
         let mesh = raybench_testkit::generated(spec, seed);
-        let bvh = Bvh::build(mesh, &with_reinsertion(BvhParams::median())).expect("builds");
+        let bvh = Bvh::build(mesh.clone(), &p).expect("builds");
+        bvh.validate(&mesh).expect("validates");
         let s = bvh.build_stats();
         let (before, after) = (
             figure(&s, "reinsert_sah_before"),
@@ -183,7 +192,7 @@ fn edge_cases_build_and_validate() {
             bvh.validate(&mesh)
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             let s = bvh.build_stats();
-            if mesh.len() > 0 {
+            if !mesh.is_empty() {
                 assert!(figure(&s, "reinsert_sah_after") <= figure(&s, "reinsert_sah_before"));
             }
         }
