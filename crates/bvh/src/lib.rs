@@ -5,7 +5,7 @@
 //! joined once; the result is a depth-first array of 64-byte nodes (each holding both
 //! children's boxes, laid out for one SIMD slab test per axis) with the triangles reordered into
 //! leaf order, and traversed
-//! from that flat form ([`traverse`]). Four registered variants share the code:
+//! from that flat form ([`traverse`]). Five registered variants share the code:
 //!
 //! | name | builder | traversal |
 //! |---|---|---|
@@ -13,6 +13,7 @@
 //! | `bvh-sweep` | full-sweep SAH | ordered |
 //! | `bvh-binned` | binned SAH (Wald 2007) | ordered |
 //! | `bvh-binned-unordered` | binned SAH | fixed child order |
+//! | `bvh-binned-reinsert` | binned SAH, then reinsertion ([`build::reinsert`]) | ordered |
 
 pub mod build;
 mod node;
