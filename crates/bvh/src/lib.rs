@@ -5,7 +5,7 @@
 //! joined once; the result is a depth-first array of 64-byte nodes (each holding both
 //! children's boxes, laid out for one SIMD slab test per axis) with the triangles reordered into
 //! leaf order, and traversed
-//! from that flat form ([`traverse`]). Four registered variants share the code:
+//! from that flat form ([`traverse`]). Five registered variants share the code:
 //!
 //! | name | builder | traversal |
 //! |---|---|---|
@@ -13,6 +13,7 @@
 //! | `bvh-sweep` | full-sweep SAH | ordered |
 //! | `bvh-binned` | binned SAH (Wald 2007) | ordered |
 //! | `bvh-binned-unordered` | binned SAH | fixed child order |
+//! | `bvh-binned-reinsert` | binned SAH, then reinsertion ([`build::reinsert`]) | ordered |
 
 pub mod build;
 mod node;
@@ -22,6 +23,7 @@ mod traverse;
 mod validate;
 pub mod wide;
 
+pub use build::reinsert::{ReinsertStats, Reinsertion};
 pub use node::{ChildRef, MAX_DEPTH, Node};
 pub use wide::{Bvh4, Bvh8, BvhWide, NodeSimd, WideParams};
 
@@ -70,6 +72,9 @@ pub struct BvhParams {
     /// The build refuses with [`BuildError::TooLarge`] when its estimate of the memory it
     /// needs (taken before allocating anything) exceeds this.
     pub memory_limit_bytes: u64,
+    /// Optimize the built tree by reinsertion (see [`build::reinsert`]) before it is flattened
+    /// for traversal or collapsed into wide nodes; `None`: the builder's tree as it is.
+    pub reinsertion: Option<Reinsertion>,
 }
 
 impl Default for BvhParams {
@@ -94,6 +99,7 @@ impl BvhParams {
             ordered: true,
             parallel_threshold: 4096,
             memory_limit_bytes: BvhParams::MEMORY_LIMIT,
+            reinsertion: None,
         }
     }
     pub fn median() -> BvhParams {
@@ -123,10 +129,15 @@ impl BvhParams {
             Builder::Sweep => "bvh-sweep",
             Builder::Binned => "bvh-binned",
         };
-        if self.ordered {
-            base.to_string()
+        let optimized = if self.reinsertion.is_some() {
+            "-reinsert"
         } else {
-            format!("{base}-unordered")
+            ""
+        };
+        if self.ordered {
+            format!("{base}{optimized}")
+        } else {
+            format!("{base}-unordered{optimized}")
         }
     }
 }
@@ -146,6 +157,8 @@ pub struct Bvh {
     /// The mesh as built, for closest-point queries (exact vertices, not the ray layout's
     /// rounded edges).
     mesh: Arc<TriangleMesh>,
+    /// What the reinsertion optimizer did, when it ran.
+    reinsertion: Option<ReinsertStats>,
 }
 
 impl Bvh {
@@ -176,7 +189,7 @@ impl Accel for Bvh {
                 "bins >= 2 and max_leaf_size >= 1 (got {params:?})"
             )));
         }
-        let flat = build::build(&mesh, params)?;
+        let (flat, reinsertion) = build::reinsert::optimize(build::build(&mesh, params)?, params);
         let prim_ids = flat.prim_ids();
         let triangles = prim_ids
             .iter()
@@ -191,6 +204,7 @@ impl Accel for Bvh {
             triangles,
             prim_ids,
             mesh,
+            reinsertion,
         })
     }
 
@@ -204,7 +218,11 @@ impl Accel for Bvh {
         if self.triangles.is_empty() {
             return BuildStats::default();
         }
-        build::Shape::measure(&self.nodes, self.root, &self.root_bounds)
+        let mut stats = build::Shape::measure(&self.nodes, self.root, &self.root_bounds);
+        if let Some(r) = &self.reinsertion {
+            r.insert_into(&mut stats.extra);
+        }
+        stats
     }
 
     fn memory(&self) -> Memory {

@@ -21,6 +21,7 @@
 //! allocated on its own.
 
 mod prim;
+pub mod reinsert;
 mod split;
 
 pub use split::MAX_BINS;

@@ -81,6 +81,8 @@ pub struct BvhWide<const W: usize> {
     /// The packet walk for coherent batches, when asked for and the CPU has AVX-512F.
     #[cfg(target_arch = "x86_64")]
     coherent: Option<raybench_geom::packet::Avx512Packets>,
+    /// What the reinsertion optimizer did to the binary tree, when it ran.
+    reinsertion: Option<crate::ReinsertStats>,
 }
 
 /// 8 children per node, tested in one AVX2 pass per axis: the structure that races Embree.
@@ -160,7 +162,8 @@ impl<const W: usize> Accel for BvhWide<W> {
                 params.width
             )));
         }
-        let mut flat = build::build(&mesh, &params.binary)?;
+        let built = build::build(&mesh, &params.binary)?;
+        let (mut flat, reinsertion) = build::reinsert::optimize(built, &params.binary);
         let mut nodes = Vec::with_capacity(flat.nodes.len() / 3 + 1);
         // The collapse leaves the leaves as triangle ranges; their `Tri4`s are numbered
         // afterwards and filled in parallel.
@@ -191,6 +194,7 @@ impl<const W: usize> Accel for BvhWide<W> {
                 .coherent_packets
                 .then(raybench_geom::packet::Avx512Packets::detect)
                 .flatten(),
+            reinsertion,
         })
     }
 
@@ -200,6 +204,7 @@ impl<const W: usize> Accel for BvhWide<W> {
     fn name(&self) -> &str {
         match (W, self.params.coherent_packets) {
             (4, _) => "bvh4-binned",
+            (_, false) if self.params.binary.reinsertion.is_some() => "bvh8-reinsert",
             (_, false) => "bvh8-binned",
             (_, true) => "bvh8-packets",
         }

@@ -54,6 +54,9 @@ impl<const W: usize> BvhWide<W> {
             "avx512_registers".into(),
             self.avx512_registers() as u8 as f64,
         );
+        if let Some(r) = &self.reinsertion {
+            r.insert_into(&mut s.extra);
+        }
         s.nodes += s.leaves;
         s.sah_cost = (root_area > 0.0).then_some(sah);
         s
