@@ -7,10 +7,13 @@
 //! entry does with `rtcIntersect1M`. Trade-off: Embree's hybrid traversal walks a packet
 //! together only while enough of its lanes stay active and drops to single rays below that, so
 //! the packet pays when the rays meet the same nodes (camera rays on large triangles) and costs
-//! a little where they scatter. Caveat: lanes past the end of a batch (or of a traced range)
-//! are masked invalid; they hold copies of the last ray so that nothing Embree might read is
-//! uninitialised or unchecked. Each lane's ray is the one `rtcIntersect1` would get, field for
-//! field (tnear, tfar, mask all ones, flags 0, geomID invalid).
+//! a little where they scatter. Caveats: `rtcOccluded16` reports some rays lying in a
+//! triangle's plane as occluded where `rtcOccluded1` does not (docs/validation.md, E11), so the
+//! scene calls [`occluded16`] only with `EmbreeParams::coherent_occluded16`, which no preset
+//! sets. Lanes past the end of a batch (or of a traced range) are masked invalid; they hold
+//! copies of the last ray so that nothing Embree might read is uninitialised or unchecked. Each
+//! lane's ray is the one `rtcIntersect1` would get, field for field (tnear, tfar, mask all ones,
+//! flags 0, geomID invalid).
 
 use crate::rays::ValidRay;
 use raybench_accel::Hit;

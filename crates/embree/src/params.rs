@@ -57,9 +57,17 @@ pub struct EmbreeParams {
     /// `rtcIntersect16`/`rtcOccluded16` with `RTC_INTERSECT_CONTEXT_FLAG_COHERENT`, sixteen
     /// consecutive rays a packet (the packets `bvh8-packets` walks), laid out outside timing;
     /// the last packet of a batch masks its missing lanes invalid. Takes precedence over
-    /// `coherent_stream`. Other batches go ray by ray. Written into reports only when set.
+    /// `coherent_stream`. Other batches go ray by ray. Coherent any-hit batches go through
+    /// `rtcOccluded16` only with `coherent_occluded16`. Written into reports only when set.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub coherent_packet16: bool,
+    /// With `coherent_packet16`, coherent any-hit batches (the shadow rays) go through
+    /// `rtcOccluded16` too. Off in every preset: `rtcOccluded16` reports rays lying in a
+    /// triangle's plane as occluded where `rtcOccluded1` and brute force do not
+    /// (docs/validation.md, E11), so without it they go through `rtcOccluded1`. Written into
+    /// reports only when set.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub coherent_occluded16: bool,
 }
 
 impl EmbreeParams {
@@ -120,14 +128,17 @@ impl EmbreeParams {
 
     /// Registered name: `embree-<quality>`, with robust medium as `embree-robust` and other
     /// robust qualities as `embree-<quality>-robust`; `-packet16` appended with
-    /// `coherent_packet16`, else `-stream` with `coherent_stream`.
+    /// `coherent_packet16` (`-packet16-occluded16` with `coherent_occluded16` too), else
+    /// `-stream` with `coherent_stream`.
     pub fn name(&self) -> String {
         let name = match (self.quality, self.robust) {
             (q, false) => format!("embree-{}", q.name()),
             (Quality::Medium, true) => "embree-robust".to_string(),
             (q, true) => format!("embree-{}-robust", q.name()),
         };
-        if self.coherent_packet16 {
+        if self.coherent_packet16 && self.coherent_occluded16 {
+            name + "-packet16-occluded16"
+        } else if self.coherent_packet16 {
             name + "-packet16"
         } else if self.coherent_stream {
             name + "-stream"

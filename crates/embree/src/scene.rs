@@ -435,13 +435,15 @@ impl Accel for EmbreeScene {
         out: &mut [bool],
     ) {
         let prepared = prepared_batch(prepared);
-        if let Some(packets) = prepared.packets16().and_then(|p| p.range(first, out.len())) {
+        if self.params.coherent_occluded16
+            && let Some(packets) = prepared.packets16().and_then(|p| p.range(first, out.len()))
+        {
             // SAFETY: `self.scene` is committed and alive for as long as `self`.
             return unsafe { crate::packet16::occluded16(self.scene.0, packets, out) };
         }
-        // The stream entry's coherent any-hit batches go ray by ray: through rtcOccluded1M,
-        // rays lying in a triangle's plane were reported occluded, which rtcOccluded1 and brute
-        // force do not report.
+        // Coherent any-hit batches otherwise go ray by ray: through rtcOccluded1M and
+        // rtcOccluded16, rays lying in a triangle's plane were reported occluded, which
+        // rtcOccluded1 and brute force do not report (docs/validation.md, E11).
         let batch = prepared.slice(first, out.len());
         for (o, &ray) in out.iter_mut().zip(batch) {
             *o = self.occluded_valid(ray);

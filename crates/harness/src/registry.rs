@@ -240,7 +240,7 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<EmbreeScene>(
             "embree-medium-packet16",
-            "embree-medium; coherent batches (primary rays for closest hit, shadow rays for any hit) traced through rtcIntersect16 / rtcOccluded16 with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, sixteen consecutive rays a packet as bvh8-packets takes them (laid out outside timing, missing lanes of a last packet masked invalid), every other batch as embree-medium",
+            "embree-medium; coherent closest-hit batches (primary rays) traced through rtcIntersect16 with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, sixteen consecutive rays a packet as bvh8-packets takes them (laid out outside timing, missing lanes of a last packet masked invalid), every other batch as embree-medium (shadow rays through rtcOccluded1: rtcOccluded16 misreports rays in a triangle's plane)",
             None,
             embree(EmbreeParams::medium_packet16()),
         ),
