@@ -168,7 +168,7 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<KdTree>(
             "kd-packets",
-            "the kd-sah tree; coherent closest-hit batches (primary rays) traced sixteen rays a packet, one per AVX-512 lane (Wald 2004), every other batch (shadow rays too) ray by ray as kd-sah",
+            "the kd-sah tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane (Wald 2004), every other batch ray by ray as kd-sah",
             None,
             |_| KdParams::packets(),
         ),
