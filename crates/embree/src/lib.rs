@@ -15,6 +15,7 @@ mod device;
 mod error;
 pub mod fpu;
 mod info;
+mod packet16;
 mod params;
 mod point;
 mod rays;

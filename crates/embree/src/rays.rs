@@ -89,6 +89,9 @@ pub struct PreparedEmbreeRays {
     /// Trace through Embree's stream API with the coherent flag
     /// ([`crate::EmbreeParams::coherent_stream`]).
     coherent: bool,
+    /// The same rays as 16-wide packets, for `rtcIntersect16`/`rtcOccluded16`
+    /// ([`crate::EmbreeParams::coherent_packet16`]).
+    packets16: Option<crate::packet16::Packets16>,
 }
 
 impl PreparedEmbreeRays {
@@ -102,7 +105,18 @@ impl PreparedEmbreeRays {
         Ok(PreparedEmbreeRays {
             rays,
             coherent: false,
+            packets16: None,
         })
+    }
+
+    /// The same rays, also laid out as 16-wide packets.
+    pub(crate) fn with_packets16(self) -> PreparedEmbreeRays {
+        let packets16 = Some(crate::packet16::Packets16::new(&self.rays));
+        PreparedEmbreeRays { packets16, ..self }
+    }
+
+    pub(crate) fn packets16(&self) -> Option<&crate::packet16::Packets16> {
+        self.packets16.as_ref()
     }
 
     /// The same rays, to be traced through the stream API as a coherent batch or not.

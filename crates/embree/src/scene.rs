@@ -398,9 +398,12 @@ impl Accel for EmbreeScene {
 
     fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
         let batch = self.prepare_checked(rays).map_err(|bad| bad.error)?;
-        Ok(PreparedRays::Foreign(Box::new(
-            batch.coherent(self.params.coherent_stream),
-        )))
+        let batch = if self.params.coherent_packet16 {
+            batch.with_packets16()
+        } else {
+            batch.coherent(self.params.coherent_stream)
+        };
+        Ok(PreparedRays::Foreign(Box::new(batch)))
     }
 
     fn intersect_prepared(
@@ -411,6 +414,10 @@ impl Accel for EmbreeScene {
         out: &mut [Option<Hit>],
     ) {
         let prepared = prepared_batch(prepared);
+        if let Some(packets) = prepared.packets16().and_then(|p| p.range(first, out.len())) {
+            // SAFETY: `self.scene` is committed and alive for as long as `self`.
+            return unsafe { crate::packet16::intersect16(self.scene.0, packets, out) };
+        }
         let batch = prepared.slice(first, out.len());
         if prepared.is_coherent() {
             return self.intersect_stream(batch, out);
@@ -427,10 +434,17 @@ impl Accel for EmbreeScene {
         first: usize,
         out: &mut [bool],
     ) {
-        // Coherent or not, ray by ray: the packet walks compared are closest-hit ones (a
-        // coherent any-hit batch through rtcOccluded1M reported rays lying in a triangle's
-        // plane as occluded, which rtcOccluded1 and brute force do not).
-        let batch = prepared_batch(prepared).slice(first, out.len());
+        let prepared = prepared_batch(prepared);
+        if self.params.coherent_occluded16
+            && let Some(packets) = prepared.packets16().and_then(|p| p.range(first, out.len()))
+        {
+            // SAFETY: `self.scene` is committed and alive for as long as `self`.
+            return unsafe { crate::packet16::occluded16(self.scene.0, packets, out) };
+        }
+        // Coherent any-hit batches otherwise go ray by ray: through rtcOccluded1M and
+        // rtcOccluded16, rays lying in a triangle's plane were reported occluded, which
+        // rtcOccluded1 and brute force do not report (docs/validation.md, E11).
+        let batch = prepared.slice(first, out.len());
         for (o, &ray) in out.iter_mut().zip(batch) {
             *o = self.occluded_valid(ray);
         }

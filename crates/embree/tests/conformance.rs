@@ -30,6 +30,13 @@ fn embree_medium_stream_conforms() {
     check(EmbreeParams::medium_stream());
 }
 
+/// Coherent batches through `rtcIntersect16`/`rtcOccluded16` (the coherent-batch check runs
+/// ranges that end inside a packet and one that starts off a packet boundary).
+#[test]
+fn embree_medium_packet16_conforms() {
+    check(EmbreeParams::medium_packet16());
+}
+
 #[test]
 fn embree_high_conforms() {
     check(EmbreeParams::high());

@@ -172,7 +172,7 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<Bvh8>(
             "bvh8-packets",
-            "the bvh8-binned tree; coherent batches (primary rays) traced sixteen rays a packet, one per AVX-512 lane, every other batch ray by ray as bvh8-binned",
+            "the bvh8-binned tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane, every other batch ray by ray as bvh8-binned",
             None,
             |_| WideParams {
                 coherent_packets: true,
@@ -187,7 +187,7 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<KdTree>(
             "kd-packets",
-            "the kd-sah tree; coherent batches (primary rays) traced sixteen rays a packet, one per AVX-512 lane (Wald 2004), every other batch ray by ray as kd-sah",
+            "the kd-sah tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane (Wald 2004), every other batch ray by ray as kd-sah",
             None,
             |_| KdParams::packets(),
         ),
@@ -253,9 +253,15 @@ pub fn registry() -> Vec<StructureEntry> {
         ),
         register::<EmbreeScene>(
             "embree-medium-stream",
-            "embree-medium; coherent batches (primary rays) traced for closest hit through rtcIntersect1M with RTC_INTERSECT_CONTEXT_FLAG_COHERENT (Embree's own packets), every other batch as embree-medium",
+            "embree-medium; coherent closest-hit batches (primary rays) traced through rtcIntersect1M with RTC_INTERSECT_CONTEXT_FLAG_COHERENT (Embree's own packets), every other batch (shadow rays too) as embree-medium",
             None,
             embree(EmbreeParams::medium_stream()),
+        ),
+        register::<EmbreeScene>(
+            "embree-medium-packet16",
+            "embree-medium; coherent closest-hit batches (primary rays) traced through rtcIntersect16 with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, sixteen consecutive rays a packet as bvh8-packets takes them (laid out outside timing, missing lanes of a last packet masked invalid), every other batch as embree-medium (shadow rays through rtcOccluded1: rtcOccluded16 misreports rays in a triangle's plane)",
+            None,
+            embree(EmbreeParams::medium_packet16()),
         ),
         register::<EmbreeScene>(
             "embree-high",

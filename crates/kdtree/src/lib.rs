@@ -66,9 +66,9 @@ pub struct KdParams {
     /// A node with at most this many triangles is a leaf without trying any split. The SAH
     /// builder also stops whenever no split is cheaper than intersecting every triangle.
     pub leaf_size: u32,
-    /// Trace coherent batches (`Accel::prepare_coherent_rays`: camera rays in scanline order)
-    /// as packets of sixteen rays on CPUs with AVX-512F; other batches, any-hit queries and
-    /// other CPUs take the single-ray walk.
+    /// Trace coherent batches (`Accel::prepare_coherent_rays`: camera rays in scanline order,
+    /// and the shadow rays from their hits) as packets of sixteen rays on CPUs with AVX-512F,
+    /// for closest or any hit; other batches and other CPUs take the single-ray walk.
     pub packets: bool,
     /// Record tested triangles in a small per-ray table so a triangle referenced by several
     /// leaves is tested once (skips are counted as `mailbox_skips`).
@@ -309,6 +309,25 @@ impl Accel for KdTree {
         }
         for (o, ray) in out.iter_mut().zip(&rays[first..]) {
             *o = self.intersect(ray);
+        }
+    }
+
+    fn occluded_prepared(
+        &self,
+        rays: &[Ray],
+        prepared: &PreparedRays,
+        first: usize,
+        out: &mut [bool],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(k) = self.coherent
+            && let Some(blocks) =
+                raybench_accel::coherent::packet_blocks(prepared, first, out.len())
+        {
+            return packets::occluded_coherent(k, self, &rays[first..], blocks, out);
+        }
+        for (o, ray) in out.iter_mut().zip(&rays[first..]) {
+            *o = self.occluded(ray);
         }
     }
 

@@ -18,7 +18,10 @@
 //! mailbox: a triangle met again in a later leaf gives the same answer again, so re-testing it
 //! costs time, never correctness. Every lane therefore meets exactly the leaves and triangles its
 //! single-ray walk meets, in the same order; its hit, `t`, `u` and `v` are the single-ray
-//! walk's. Closest hit only: any-hit batches and incoherent batches take the single-ray walk.
+//! walk's. Any hit (the shadow rays, coherent in the same way): a lane is done at the first leaf
+//! where it hits and leaves every subtree still on the stack; the packet ends when all its lanes
+//! are done. Its leaves up to that one are its single-ray any-hit walk's, in the same order, so
+//! its answer is that walk's. Incoherent batches take the single-ray walk.
 #![allow(unsafe_code)]
 
 use crate::KdTree;
@@ -51,13 +54,7 @@ pub(crate) fn intersect_coherent(
     blocks: &[RayBlock],
     out: &mut [Option<Hit>],
 ) {
-    let empty = Entry {
-        t0: [0.0; PACKET],
-        t1: [0.0; PACKET],
-        node: 0,
-        lanes: 0,
-    };
-    let mut stack: Box<PacketStack> = Box::new([empty; MAX_DEPTH + 1]);
+    let mut stack = new_stack();
     // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
     unsafe { intersect_packets(kd, rays, blocks, out, &mut stack) }
 }
@@ -76,31 +73,93 @@ fn intersect_packets(
         .zip(rays.chunks(PACKET))
     {
         let (p, mut best) = packet::load(block);
-        if !kd.nodes.is_empty() {
-            // Each lane's segment in the root cell: its single-ray walk's own slab test.
-            let (mut t0, mut t1, mut inside) = ([0.0f32; PACKET], [0.0f32; PACKET], 0u16);
-            for (lane, ray) in rays.iter().enumerate().take(out.len()) {
-                if let Some((enter, exit)) = kd.bounds.intersect(ray) {
-                    (t0[lane], t1[lane]) = (enter, exit);
-                    inside |= 1 << lane;
-                }
-            }
-            packet::octant_groups(&p, out.len(), |lanes, octant| {
-                if lanes & inside != 0 {
-                    walk(kd, &p, lanes & inside, octant, (&t0, &t1), &mut best, stack);
-                }
-            });
-        }
+        walk_packet::<false>(kd, &p, rays, out.len(), &mut best, stack);
         for (o, (prim, h)) in out.iter_mut().zip(best.hits()) {
             *o = (prim != NO_PRIM).then(|| Hit::from_tri_hit(prim, h));
         }
     }
 }
 
-/// The walk of the `active` lanes, whose directions all lie in `octant`, from their root
-/// intervals `start`.
+/// Traces a coherent batch (any hit), one packet per block, as [`intersect_coherent`].
+pub(crate) fn occluded_coherent(
+    _k: Avx512Packets,
+    kd: &KdTree,
+    rays: &[Ray],
+    blocks: &[RayBlock],
+    out: &mut [bool],
+) {
+    let mut stack = new_stack();
+    // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
+    unsafe { occluded_packets(kd, rays, blocks, out, &mut stack) }
+}
+
 #[target_feature(enable = "avx512f")]
-fn walk(
+fn occluded_packets(
+    kd: &KdTree,
+    rays: &[Ray],
+    blocks: &[RayBlock],
+    out: &mut [bool],
+    stack: &mut PacketStack,
+) {
+    for ((block, out), rays) in blocks
+        .iter()
+        .zip(out.chunks_mut(PACKET))
+        .zip(rays.chunks(PACKET))
+    {
+        let (p, mut best) = packet::load(block);
+        let done = walk_packet::<true>(kd, &p, rays, out.len(), &mut best, stack);
+        for (lane, o) in out.iter_mut().enumerate() {
+            *o = done >> lane & 1 == 1;
+        }
+    }
+}
+
+/// One packet of the first `len` of `rays`, walked once per direction octant present; returns
+/// the lanes that found a hit (any hit) or 0 (closest hit, whose answers are in `best`).
+#[target_feature(enable = "avx512f")]
+fn walk_packet<const ANY_HIT: bool>(
+    kd: &KdTree,
+    p: &Packet,
+    rays: &[Ray],
+    len: usize,
+    best: &mut Best,
+    stack: &mut PacketStack,
+) -> u16 {
+    let mut done = 0;
+    if kd.nodes.is_empty() {
+        return done;
+    }
+    // Each lane's segment in the root cell: its single-ray walk's own slab test.
+    let (mut t0, mut t1, mut inside) = ([0.0f32; PACKET], [0.0f32; PACKET], 0u16);
+    for (lane, ray) in rays.iter().enumerate().take(len) {
+        if let Some((enter, exit)) = kd.bounds.intersect(ray) {
+            (t0[lane], t1[lane]) = (enter, exit);
+            inside |= 1 << lane;
+        }
+    }
+    packet::octant_groups(p, len, |lanes, octant| {
+        if lanes & inside != 0 {
+            done |= walk::<ANY_HIT>(kd, p, lanes & inside, octant, (&t0, &t1), best, stack);
+        }
+    });
+    done
+}
+
+fn new_stack() -> Box<PacketStack> {
+    let empty = Entry {
+        t0: [0.0; PACKET],
+        t1: [0.0; PACKET],
+        node: 0,
+        lanes: 0,
+    };
+    Box::new([empty; MAX_DEPTH + 1])
+}
+
+/// The walk of the `active` lanes, whose directions all lie in `octant`, from their root
+/// intervals `start`; with `ANY_HIT`, returns the lanes that found a hit (each done at its
+/// first), else 0.
+#[target_feature(enable = "avx512f")]
+fn walk<const ANY_HIT: bool>(
     kd: &KdTree,
     p: &Packet,
     active: u16,
@@ -108,7 +167,7 @@ fn walk(
     start: (&[f32; PACKET], &[f32; PACKET]),
     best: &mut Best,
     stack: &mut PacketStack,
-) {
+) -> u16 {
     // SAFETY: `start`'s arrays and every entry's are 16 initialised f32s; `loadu` and
     // `storeu` need no alignment.
     let load = |a: &[f32; PACKET]| unsafe { _mm512_loadu_ps(a.as_ptr()) };
@@ -120,6 +179,8 @@ fn walk(
     };
     let (mut t0, mut t1) = (load(start.0), load(start.1));
     let mut lanes = active;
+    let mut live = active;
+    let none = _mm512_set1_epi32(NO_PRIM as i32);
     let mut at = 0u32;
     let mut sp = 0;
     'walk: loop {
@@ -158,6 +219,12 @@ fn walk(
         for four in &kd.tri4s[first / LANES..(first + count).div_ceil(LANES)] {
             best.test_tri4(four, p, lanes);
         }
+        if ANY_HIT {
+            live &= !_mm512_mask_cmpneq_epi32_mask(lanes, best.prim, none);
+            if live == 0 {
+                break 'walk;
+            }
+        }
         loop {
             if sp == 0 {
                 break 'walk;
@@ -166,7 +233,7 @@ fn walk(
             let e = &stack[sp];
             let enter = load(&e.t0);
             // Lanes whose interval starts beyond their closest hit are done with it.
-            let keep = _mm512_mask_cmp_ps_mask::<_CMP_NGT_UQ>(e.lanes, enter, best.t);
+            let keep = _mm512_mask_cmp_ps_mask::<_CMP_NGT_UQ>(e.lanes & live, enter, best.t);
             if keep != 0 {
                 (at, lanes, t0) = (e.node, keep, enter);
                 t1 = _mm512_min_ps(load(&e.t1), best.t);
@@ -174,4 +241,5 @@ fn walk(
             }
         }
     }
+    active & !live
 }

@@ -21,6 +21,7 @@ mod check;
 mod lattice;
 pub mod points;
 mod rays;
+mod shadow;
 
 pub use cases::{Case, edge_cases, seeded_cases};
 pub use check::{check_case, expect_too_large, packets_against_single_rays, valid_rays};
@@ -28,6 +29,7 @@ pub use lattice::{check_lattice, lattice_rays, lattice_scene};
 /// The scene generators, for structure crates' tests (which depend on testkit, not on scenes).
 pub use raybench_scenes as scenes;
 pub use rays::{camera_ray_sets, centroid_rays, random_rays_in, refused_rays, seeded_rng};
+pub use shadow::{occlusion_packets_against_single_rays, shadow_ray_sets};
 
 use raybench_accel::Accel;
 use raybench_accel::classify::VerdictCounts;

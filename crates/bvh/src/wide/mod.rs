@@ -24,7 +24,7 @@
 //! answers. An 8-wide node is tested in one 8-lane AVX2 pass per axis when the CPU has AVX2
 //! (detected at build time) and in two 4-lane SSE passes otherwise (`kernels.rs`); every
 //! kernel is the scalar slab test lane for lane and passes the same conformance tests.
-//! Coherent batches may be traced sixteen rays a packet (`packets.rs`).
+//! Coherent batches may be traced sixteen rays a packet (`packets.rs`), for closest or any hit.
 //!
 //! Caveat: the collapse only regroups the binary builder's partitions (and splits leaves), so
 //! the wide tree is as good as the binary SAH build under it; and the knobs
@@ -248,7 +248,20 @@ impl<const W: usize> Accel for BvhWide<W> {
         }
     }
 
-    fn occluded_prepared(&self, rays: &[Ray], _: &PreparedRays, first: usize, out: &mut [bool]) {
+    fn occluded_prepared(
+        &self,
+        rays: &[Ray],
+        prepared: &PreparedRays,
+        first: usize,
+        out: &mut [bool],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(k) = self.coherent
+            && let Some(packets) =
+                raybench_accel::coherent::packet_blocks(prepared, first, out.len())
+        {
+            return packets::occluded_coherent(k, self, packets, out);
+        }
         let mut stack = new_stack();
         let rays = &rays[first..];
         #[cfg(target_arch = "x86_64")]

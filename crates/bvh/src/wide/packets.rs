@@ -30,6 +30,15 @@
 //!
 //! A subtree pushed for later keeps the smallest entry distance among its rays and is skipped
 //! when that is beyond every active ray's closest hit so far.
+//!
+//! Any hit (shadow rays from primary hits towards one light, coherent in the same way): a lane
+//! is done at its first hit and leaves every subtree still to visit; the packet ends when all
+//! its lanes are done or the stack is empty. Children are pushed in slot order, unsorted, as in
+//! the single-ray any-hit walk (no hit shortens a ray, so no distance would ever cull one). A
+//! lane tests exactly the boxes and triangles of its single-ray any-hit walk that come before
+//! its first hit in the packet's order, with the same arithmetic, so its answer is the single-ray
+//! walk's: occluded exactly when one of the leaves its ray enters holds a triangle hit within
+//! `t_min < t <= t_max`.
 
 use crate::node::ChildRef;
 use crate::wide::{BvhWide, STACK};
@@ -164,4 +173,119 @@ fn push_sorted(stack: &mut PacketStack, base: usize, sp: &mut usize, e: Entry) {
     }
     stack[j] = e;
     *sp += 1;
+}
+
+/// Traces a coherent batch (any hit), one packet per block; `out` gets the first `out.len()`
+/// rays of `blocks`.
+pub(crate) fn occluded_coherent<const W: usize>(
+    _k: Avx512Packets,
+    bvh: &BvhWide<W>,
+    blocks: &[RayBlock],
+    out: &mut [bool],
+) {
+    let mut stack: Box<PacketStack> = Box::new([Entry::default(); STACK]);
+    // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
+    unsafe { occluded_packets(bvh, blocks, out, &mut stack) }
+}
+
+#[target_feature(enable = "avx512f")]
+fn occluded_packets<const W: usize>(
+    bvh: &BvhWide<W>,
+    blocks: &[RayBlock],
+    out: &mut [bool],
+    stack: &mut PacketStack,
+) {
+    for (block, out) in blocks.iter().zip(out.chunks_mut(PACKET)) {
+        let (packet, mut best) = packet::load(block);
+        let mut done = 0u16;
+        if !bvh.tri4s().is_empty() {
+            packet::octant_groups(&packet, out.len(), |lanes, octant| {
+                done |= walk_any(bvh, &packet, lanes, octant, &mut best, stack)
+            });
+        }
+        for (lane, o) in out.iter_mut().enumerate() {
+            *o = done >> lane & 1 == 1;
+        }
+    }
+}
+
+/// The any-hit walk of the `active` lanes, whose directions all lie in `octant`; returns the
+/// lanes that found a hit. `best` enters with each lane's `t_max` and is used only to test
+/// triangles: a lane with a hit in it is done.
+#[target_feature(enable = "avx512f")]
+fn walk_any<const W: usize>(
+    bvh: &BvhWide<W>,
+    p: &Packet,
+    active: u16,
+    octant: u8,
+    best: &mut Best,
+    stack: &mut PacketStack,
+) -> u16 {
+    let near = [0, 1, 2].map(|a| (octant >> a & 1) as usize);
+    let t_max = best.t;
+    let none = _mm512_set1_epi32(NO_PRIM as i32);
+    let mut live = active;
+    let mut sp = 0;
+    let mut r = bvh.root();
+    let mut lanes = active;
+    'walk: loop {
+        if r.is_leaf() {
+            let first = r.index as usize;
+            for tri4 in &bvh.tri4s()[first..first + (r.count as usize).div_ceil(4)] {
+                best.test_tri4(tri4, p, lanes);
+                let hit = _mm512_mask_cmpneq_epi32_mask(lanes, best.prim, none);
+                if hit != 0 {
+                    live &= !hit;
+                    lanes &= !hit;
+                    if live == 0 {
+                        break 'walk;
+                    }
+                    if lanes == 0 {
+                        break;
+                    }
+                }
+            }
+        } else {
+            let n = &bvh.nodes()[r.index as usize];
+            let base = sp;
+            for slot in 0..W {
+                let child = n.child[slot];
+                if child == ChildRef::default() {
+                    break;
+                }
+                let mut t0 = p.t_min;
+                let mut t1 = t_max;
+                for (a, &near) in near.iter().enumerate() {
+                    let lo = _mm512_set1_ps(n.planes[a][near][slot]);
+                    let hi = _mm512_set1_ps(n.planes[a][1 - near][slot]);
+                    t0 = _mm512_max_ps(_mm512_mul_ps(_mm512_sub_ps(lo, p.origin[a]), p.inv[a]), t0);
+                    t1 = _mm512_min_ps(_mm512_mul_ps(_mm512_sub_ps(hi, p.origin[a]), p.inv[a]), t1);
+                }
+                let entered = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(lanes, t0, t1);
+                if entered != 0 {
+                    stack[sp] = Entry {
+                        r: child,
+                        t_entry: 0.0,
+                        lanes: entered,
+                    };
+                    sp += 1;
+                }
+            }
+            // The lowest slot first, as the single-ray any-hit walk.
+            stack[base..sp].reverse();
+        }
+        // The next subtree some lane that entered it still needs.
+        loop {
+            if sp == 0 {
+                break 'walk;
+            }
+            sp -= 1;
+            let e = stack[sp];
+            if e.lanes & live != 0 {
+                (r, lanes) = (e.r, e.lanes & live);
+                continue 'walk;
+            }
+        }
+    }
+    active & !live
 }

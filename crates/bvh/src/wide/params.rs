@@ -34,8 +34,9 @@ pub struct WideParams {
     /// Split leaves of more than one `Tri4` into the slots a node would leave empty (see
     /// `collapse.rs`); off, the wide tree has exactly the binary tree's leaves.
     pub fill_slots: bool,
-    /// Batches prepared as coherent (`Accel::prepare_coherent_rays`: the primary rays) are
-    /// traced for closest hit sixteen rays at a time, one per AVX-512 lane (`packets.rs`),
+    /// Batches prepared as coherent (`Accel::prepare_coherent_rays`: the primary and shadow
+    /// rays) are traced for closest or any hit sixteen rays at a time, one per AVX-512 lane
+    /// (`packets.rs`),
     /// when the CPU has AVX-512F; every other batch, and every batch without AVX-512, ray by
     /// ray. The registry's `bvh8-packets`.
     pub coherent_packets: bool,

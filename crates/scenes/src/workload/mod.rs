@@ -96,10 +96,13 @@ impl Workload {
         matches!(self, Workload::Shadow)
     }
 
-    /// True when consecutive rays are coherent (camera rays in scanline order): the batch is
-    /// prepared with `Accel::prepare_coherent_rays`, so structures may trace it in packets.
+    /// True when consecutive rays are coherent: the batch is prepared with
+    /// `Accel::prepare_coherent_rays`, so structures may trace it in packets. Camera rays in
+    /// scanline order are; so are shadow rays, which start at those rays' hits in the same
+    /// order and all end at one light (a pixel that gives no shadow ray only closes the gap
+    /// between its neighbours).
     pub fn coherent(&self) -> bool {
-        matches!(self, Workload::Primary)
+        matches!(self, Workload::Primary | Workload::Shadow)
     }
 
     /// True when the rays start at the primary rays' hits.
@@ -119,7 +122,7 @@ impl Workload {
                 "origins uniform in the scene box enlarged by 5% per side, directions uniform on the sphere: incoherent, closest hit"
             }
             Workload::Shadow => {
-                "from each primary hit that faces the light towards the light, ending just before it: any hit (occlusion)"
+                "from each primary hit that faces the light towards the light, ending just before it, in pixel order: coherent, any hit (occlusion)"
             }
             Workload::Diffuse => {
                 "from each primary hit, cosine-weighted over the facing hemisphere: incoherent, closest hit (path tracing bounce)"
