@@ -15,6 +15,7 @@
 //! | `bvh-binned-unordered` | binned SAH | fixed child order |
 
 pub mod build;
+mod cover;
 mod node;
 mod point;
 mod simd;
@@ -22,6 +23,7 @@ mod traverse;
 mod validate;
 pub mod wide;
 
+pub use build::SpatialSplits;
 pub use node::{ChildRef, MAX_DEPTH, Node};
 pub use wide::{Bvh4, Bvh8, BvhWide, NodeSimd, WideParams};
 
@@ -70,6 +72,8 @@ pub struct BvhParams {
     /// The build refuses with [`BuildError::TooLarge`] when its estimate of the memory it
     /// needs (taken before allocating anything) exceeds this.
     pub memory_limit_bytes: u64,
+    /// Spatial splits (a Split BVH, see `build/spatial`): `None` builds object splits only.
+    pub spatial_splits: Option<SpatialSplits>,
 }
 
 impl Default for BvhParams {
@@ -94,6 +98,7 @@ impl BvhParams {
             ordered: true,
             parallel_threshold: 4096,
             memory_limit_bytes: BvhParams::MEMORY_LIMIT,
+            spatial_splits: None,
         }
     }
     pub fn median() -> BvhParams {
@@ -116,9 +121,18 @@ impl BvhParams {
         }
     }
 
+    /// The binned builder with spatial splits at their defaults.
+    pub fn sbvh() -> BvhParams {
+        BvhParams {
+            spatial_splits: Some(SpatialSplits::default()),
+            ..BvhParams::binned()
+        }
+    }
+
     /// The registered name of this configuration.
     pub fn name(&self) -> String {
         let base = match self.builder {
+            _ if self.spatial_splits.is_some() => "bvh-sbvh",
             Builder::Median => "bvh-median",
             Builder::Sweep => "bvh-sweep",
             Builder::Binned => "bvh-binned",
@@ -143,6 +157,8 @@ pub struct Bvh {
     root_bounds: raybench_geom::Aabb,
     triangles: Vec<MollerTriangle>,
     prim_ids: Vec<u32>,
+    /// What spatial splits did (`None` without them).
+    spatial: Option<build::SpatialReport>,
     /// The mesh as built, for closest-point queries (exact vertices, not the ray layout's
     /// rounded edges).
     mesh: Arc<TriangleMesh>,
@@ -190,6 +206,7 @@ impl Accel for Bvh {
             root_bounds: flat.root_bounds,
             triangles,
             prim_ids,
+            spatial: flat.spatial,
             mesh,
         })
     }
@@ -204,7 +221,9 @@ impl Accel for Bvh {
         if self.triangles.is_empty() {
             return BuildStats::default();
         }
-        build::Shape::measure(&self.nodes, self.root, &self.root_bounds)
+        let mut stats = build::Shape::measure(&self.nodes, self.root, &self.root_bounds);
+        build::spatial_stats(&mut stats, self.spatial, self.mesh.len());
+        stats
     }
 
     fn memory(&self) -> Memory {
