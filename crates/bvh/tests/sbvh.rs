@@ -52,7 +52,7 @@ fn wide_sbvh_conforms_on_the_shared_scenes() {
 /// against brute force, with validation.
 #[test]
 fn sbvh_conforms_on_fibres() {
-    for (spec, seed) in [("hair", 3), ("soup:triangles=2000", 11)] {
+    for (spec, seed) in [("hair:triangles=5000", 3), ("soup:triangles=2000", 11)] {
         let mesh = raybench_testkit::generated(spec, seed);
         let mut rays = raybench_testkit::random_rays_in(&mesh.bounds().enlarged(0.1), 4000, seed);
         rays.extend(raybench_testkit::centroid_rays(&mesh, 4000, seed ^ 1));

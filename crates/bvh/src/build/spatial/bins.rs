@@ -1,11 +1,11 @@
 //! The search for the best spatial split of a node: per axis, `spatial_bins` equal slabs of the
 //! node's box (not of its centroids), each reference chopped into the slabs it crosses (its
-//! triangle clipped at every slab plane, [`split_at`]), counting where it enters and where it
+//! triangle clipped at every slab plane, [`split_estimate`]), counting where it enters and where it
 //! leaves; then one sweep over the slab boundaries evaluates the SAH of cutting every
 //! reference at that plane (Stich, Friedrich and Dietrich 2009, section 4.2). A boundary whose
 //! cut would duplicate more references than the node's budget allows is not a candidate.
 
-use super::chop::{Corners, corners, is_empty, split_at};
+use super::chop::{Corners, corners, is_empty, split_estimate};
 use crate::BvhParams;
 use crate::build::split::split_cost;
 use crate::build::{Box3, PrimRef};
@@ -143,7 +143,7 @@ fn chop_into_slabs(
     let (first, last) = (*range.start(), *range.end());
     let mut rest = b;
     for s in first..last {
-        let (piece, beyond) = split_at(tri, axis, plane(s + 1), &rest);
+        let (piece, beyond) = split_estimate(tri, axis, plane(s + 1), &rest);
         if !is_empty(&piece) {
             boxes[s] = boxes[s].union(&piece);
         }

@@ -44,6 +44,31 @@ pub(crate) fn split_at(tri: &Corners, axis: usize, pos: f32, within: &Box3) -> (
     (intersect(&left, within), intersect(&right, within))
 }
 
+/// [`split_at`] in f32 without the outward rounding, for the binning's estimates only (the
+/// split itself goes through [`split_at`]): the binning chops every reference at every slab
+/// plane it crosses, and the exact crossings were three quarters of the build (measured on
+/// hair, 50,000 triangles, with `perf`).
+#[inline]
+pub(crate) fn split_estimate(tri: &Corners, axis: usize, pos: f32, within: &Box3) -> (Box3, Box3) {
+    let (mut left, mut right) = (Box3::EMPTY, Box3::EMPTY);
+    for i in 0..3 {
+        let (a, b) = (tri[i], tri[(i + 1) % 3]);
+        let (da, db) = (a[axis] - pos, b[axis] - pos);
+        if da <= 0.0 {
+            left = left.grow(a);
+        }
+        if da >= 0.0 {
+            right = right.grow(a);
+        }
+        if (da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0) {
+            let p = a + (b - a) * (da / (da - db));
+            left = left.grow(p);
+            right = right.grow(p);
+        }
+    }
+    (intersect(&left, within), intersect(&right, within))
+}
+
 /// Where the edge `a`–`b` crosses the plane, as a box of at most one ulp per axis around the
 /// exact point (the plane's own coordinate exactly `pos`).
 fn crossing(a: Vec3A, b: Vec3A, axis: usize, pos: f32) -> (Vec3A, Vec3A) {
