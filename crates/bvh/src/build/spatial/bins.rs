@@ -142,10 +142,10 @@ fn chop_into_slabs(
 ) {
     let (first, last) = (*range.start(), *range.end());
     let mut rest = b;
-    for s in first..last {
+    for (s, slab) in boxes.iter_mut().enumerate().take(last).skip(first) {
         let (piece, beyond) = split_estimate(tri, axis, plane(s + 1), &rest);
         if !is_empty(&piece) {
-            boxes[s] = boxes[s].union(&piece);
+            *slab = slab.union(&piece);
         }
         if is_empty(&beyond) {
             return;
