@@ -164,3 +164,28 @@ impl<const W: usize> BvhWide<W> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::{Bvh8, WideParams};
+    use raybench_accel::Accel;
+
+    /// The wide validator, on the collapsed tree: a leaf box cut in half leaves its triangles
+    /// uncovered.
+    #[test]
+    fn the_wide_validator_catches_a_shrunk_leaf() {
+        let mesh = raybench_testkit::generated("hair:triangles=2000", 4);
+        let mut bvh = Bvh8::build(mesh.clone(), &WideParams::sbvh()).expect("builds");
+        bvh.validate(&mesh).expect("a sound tree passes");
+        let (n, slot) = (0..bvh.nodes.len())
+            .flat_map(|n| (0..8).map(move |s| (n, s)))
+            .find(|&(n, s)| s < bvh.nodes[n].children() && bvh.nodes[n].child[s].is_leaf())
+            .expect("a leaf");
+        for axis in 0..3 {
+            let p = &mut bvh.nodes[n].planes[axis];
+            p[1][slot] = (p[0][slot] + p[1][slot]) * 0.5;
+        }
+        let err = bvh.validate(&mesh).unwrap_err();
+        assert!(err.contains("cover") || err.contains("misses"), "{err}");
+    }
+}

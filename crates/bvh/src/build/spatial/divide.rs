@@ -28,12 +28,14 @@ pub(crate) fn divide(refs: &[PrimRef], mesh: &TriangleMesh, s: &SpatialSplit) ->
     let mut duplicates = 0;
     for r in refs {
         let b = r.bounds();
-        if b.hi[axis] <= pos {
-            left.push(*r);
-            continue;
-        }
+        // A reference flat in the plane goes right, as the binning counted it (the plane is
+        // the lower face of its slab).
         if b.lo[axis] >= pos {
             right.push(*r);
+            continue;
+        }
+        if b.hi[axis] <= pos {
+            left.push(*r);
             continue;
         }
         let (lp, rp) = split_at(&corners(&mesh.triangle(r.id() as usize)), axis, pos, &b);

@@ -10,10 +10,13 @@
 //! children in proportion to their references (as Embree's spatial-split builder shares its
 //! extra space), so the tree does not depend on which task builds what first. Below a node
 //! whose own area is under the `alpha` limit (no children of it can overlap more) or whose
-//! budget is spent, the plain binned builder takes over the range. Caveat: a duplicated
+//! budget is spent, the plain binned builder takes over the range. Caveats: a duplicated
 //! triangle is tested once per reference a ray reaches, with the same answer (no mailbox: the
-//! closest hit does not change), and the references' boxes cover the triangle only up to the
-//! outward rounding of the cuts (see [`chop`]).
+//! closest hit does not change); a ray finds a triangle only because its pieces' boxes cover
+//! it, which the outward rounding of the cuts ([`chop`]) guarantees and the validators check;
+//! and the choice is greedy, node by node, so on scenes whose few huge triangles span
+//! everything (the ground of `city` and `grass`) the tree can come out no better than the
+//! binned one.
 
 mod bins;
 pub(crate) mod chop;
@@ -41,15 +44,25 @@ pub struct SpatialSplits {
     /// paper's α; 1e-5 there). 1e-4: against 1e-5, the same SAH cost within 0.7 % on Sponza,
     /// the dragon, conference and hair, for 20–40 % less build time; 1e-3 builds the dragon
     /// in half the time again but costs 1.5 % SAH on conference (`examples/sbvh_tune`,
-    /// 2 threads, 2026-11-26).
+    /// 2 threads, 2026-11-26, with `intersection_cost` at 0.15).
     pub alpha: f32,
     /// The references may number at most `(1 + max_reference_growth)` × the triangles. 0.5:
     /// hair uses all of it (SAH 8835 binned, 8130 at 0.25, 7389 at 0.5, 6870 at 1.0, build
-    /// 462, 403 and 685 ms); the real scenes stop short of it (growth 1.02 to 1.21).
+    /// 462, 403 and 685 ms); the real scenes stop short of it (growth 1.02 to 1.21; measured
+    /// with `intersection_cost` at 0.15).
     pub max_reference_growth: f32,
+    /// The SAH cost of a triangle test (a node step costing 1) in the choice between the object
+    /// and the spatial split, and between a spatial split and a leaf; the object splits keep
+    /// the binary builder's `intersection_cost`. 1: with the wide tree's 0.15 per triangle
+    /// slot, spatial splits never divide a node the object split leaves as a leaf, and random
+    /// rays test 8.18 → 6.52 triangles on Sponza (binned → SBVH) and visit 4.66 → 3.62 nodes;
+    /// with 1, 3.86 triangles and 3.87 nodes; grass 6.49 → 7.55 tests with 0.15 but 4.68 with
+    /// 1 (nodes 4.95 → 4.92 and 5.28) (`examples/sbvh_tune`, 20,000 random rays, 2026-11-26).
+    pub intersection_cost: f32,
     /// Slabs per axis in the spatial split's binning (at most [`MAX_SPATIAL_BINS`]). 16: on
     /// hair (50,000 triangles) the same SAH cost as 32 (7389 against 7394) in 403 ms instead of
-    /// 644; 8 gives 7399 in 302 ms (`examples/sbvh_tune`, 2 threads, 2026-11-26).
+    /// 644; 8 gives 7399 in 302 ms (`examples/sbvh_tune`, 2 threads, 2026-11-26, with
+    /// `intersection_cost` at 0.15).
     pub spatial_bins: u32,
 }
 
@@ -59,6 +72,7 @@ impl Default for SpatialSplits {
             alpha: 1e-4,
             max_reference_growth: 0.5,
             spatial_bins: 16,
+            intersection_cost: 1.0,
         }
     }
 }
@@ -76,6 +90,8 @@ struct Ctx<'a> {
     mesh: &'a TriangleMesh,
     /// `alpha` × the root's half area.
     min_overlap: f64,
+    /// The binary builder's knobs with the spatial splits' `intersection_cost`.
+    priced: BvhParams,
 }
 
 /// A subtree as the spatial builder returns it, before flattening.
@@ -121,6 +137,10 @@ pub(crate) fn build(mesh: &TriangleMesh, p: &BvhParams, s: &SpatialSplits) -> Fl
         s,
         mesh,
         min_overlap: s.alpha as f64 * whole.bounds.half_area(),
+        priced: BvhParams {
+            intersection_cost: s.intersection_cost,
+            ..p.clone()
+        },
     };
     let budget = (n as f64 * s.max_reference_growth.max(0.0) as f64) as usize;
     let tree = ctx.node(refs, whole, 0, budget, &mut Work::new());
@@ -154,12 +174,13 @@ impl Ctx<'_> {
         let mut refs = refs;
         let object = binned_split(&mut refs, &r, p, &mut w.binned);
         let parent = r.bounds.half_area();
+        let q = &self.priced;
         let object_cost = object.map(|o| {
             let (l, r) = (
                 (o.left.bounds.half_area(), o.mid),
                 (o.right.bounds.half_area(), n - o.mid),
             );
-            split_cost(p, parent, l, r)
+            split_cost(q, parent, l, r)
         });
         let overlap = object.map_or(f64::INFINITY, |o| {
             let both = chop::intersect(&o.left.bounds, &o.right.bounds);
@@ -174,13 +195,13 @@ impl Ctx<'_> {
                 &refs,
                 self.mesh,
                 &r.bounds,
-                p,
+                q,
                 self.s.spatial_bins as usize,
                 budget,
                 &mut w.slabs,
             )
             && object_cost.is_none_or(|c| s.cost < c)
-            && worth_splitting(p, n, s.cost)
+            && worth_splitting(q, n, s.cost)
             && let Some(d) = divide(&refs, self.mesh, &s)
         {
             drop(refs);
@@ -316,3 +337,6 @@ pub(crate) fn spatial_stats(
         stats.refs as f64 / triangles.max(1) as f64,
     );
 }
+
+#[cfg(test)]
+mod tests;
