@@ -16,6 +16,7 @@
 //! | `bvh-binned-reinsert` | binned SAH, then reinsertion ([`build::reinsert`]) | ordered |
 
 pub mod build;
+mod cover;
 mod node;
 mod point;
 mod simd;
@@ -24,6 +25,7 @@ mod validate;
 pub mod wide;
 
 pub use build::reinsert::{ReinsertStats, Reinsertion};
+pub use build::SpatialSplits;
 pub use node::{ChildRef, MAX_DEPTH, Node};
 pub use wide::{Bvh4, Bvh8, BvhWide, NodeSimd, WideParams};
 
@@ -75,6 +77,8 @@ pub struct BvhParams {
     /// Optimize the built tree by reinsertion (see [`build::reinsert`]) before it is flattened
     /// for traversal or collapsed into wide nodes; `None`: the builder's tree as it is.
     pub reinsertion: Option<Reinsertion>,
+    /// Spatial splits (a Split BVH, see `build/spatial`): `None` builds object splits only.
+    pub spatial_splits: Option<SpatialSplits>,
 }
 
 impl Default for BvhParams {
@@ -100,6 +104,7 @@ impl BvhParams {
             parallel_threshold: 4096,
             memory_limit_bytes: BvhParams::MEMORY_LIMIT,
             reinsertion: None,
+            spatial_splits: None,
         }
     }
     pub fn median() -> BvhParams {
@@ -122,9 +127,18 @@ impl BvhParams {
         }
     }
 
+    /// The binned builder with spatial splits at their defaults.
+    pub fn sbvh() -> BvhParams {
+        BvhParams {
+            spatial_splits: Some(SpatialSplits::default()),
+            ..BvhParams::binned()
+        }
+    }
+
     /// The registered name of this configuration.
     pub fn name(&self) -> String {
         let base = match self.builder {
+            _ if self.spatial_splits.is_some() => "bvh-sbvh",
             Builder::Median => "bvh-median",
             Builder::Sweep => "bvh-sweep",
             Builder::Binned => "bvh-binned",
@@ -154,6 +168,8 @@ pub struct Bvh {
     root_bounds: raybench_geom::Aabb,
     triangles: Vec<MollerTriangle>,
     prim_ids: Vec<u32>,
+    /// What spatial splits did (`None` without them).
+    spatial: Option<build::SpatialReport>,
     /// The mesh as built, for closest-point queries (exact vertices, not the ray layout's
     /// rounded edges).
     mesh: Arc<TriangleMesh>,
@@ -203,6 +219,7 @@ impl Accel for Bvh {
             root_bounds: flat.root_bounds,
             triangles,
             prim_ids,
+            spatial: flat.spatial,
             mesh,
             reinsertion,
         })
@@ -222,6 +239,7 @@ impl Accel for Bvh {
         if let Some(r) = &self.reinsertion {
             r.insert_into(&mut stats.extra);
         }
+        build::spatial_stats(&mut stats, self.spatial, self.mesh.len());
         stats
     }
 

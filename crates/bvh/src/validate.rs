@@ -6,9 +6,16 @@ use raybench_geom::TriangleMesh;
 /// Every child box inside its parent's, every leaf box containing its triangles, leaf ranges
 /// tiling the triangle array exactly once, `prim_ids` a permutation of the mesh's triangles,
 /// the reordered triangles matching the mesh, and the depth within the traversal stack.
+///
+/// With spatial splits a triangle may be in several leaves (never twice in one), and each of
+/// those leaves' boxes may hold only part of it: then every triangle must be in some leaf, and
+/// the boxes of the leaves holding it must overlap its box and together cover it
+/// ([`cover::check_references`]).
 pub(crate) fn validate(bvh: &Bvh, mesh: &TriangleMesh) -> Result<(), String> {
     let n = mesh.len();
-    if bvh.prim_ids.len() != n || bvh.triangles.len() != n {
+    let spatial = bvh.params.spatial_splits.is_some();
+    let refs = bvh.prim_ids.len();
+    if (!spatial && refs != n) || refs < n || bvh.triangles.len() != refs {
         return Err(format!(
             "{} ids / {} triangles for a mesh of {n}",
             bvh.prim_ids.len(),
@@ -20,7 +27,7 @@ pub(crate) fn validate(bvh: &Bvh, mesh: &TriangleMesh) -> Result<(), String> {
         let slot = seen
             .get_mut(id as usize)
             .ok_or(format!("prim id {id} out of range"))?;
-        if std::mem::replace(slot, true) {
+        if std::mem::replace(slot, true) && !spatial {
             return Err(format!("prim id {id} appears twice"));
         }
     }
@@ -38,17 +45,23 @@ pub(crate) fn validate(bvh: &Bvh, mesh: &TriangleMesh) -> Result<(), String> {
     }
     let mut covered = 0usize;
     let mut interior = 0usize;
+    let mut pieces = spatial.then(Vec::new);
     walk(
         bvh,
         mesh,
         bvh.root,
         &bvh.root_bounds,
         0,
-        &mut covered,
-        &mut interior,
+        (&mut covered, &mut interior),
+        &mut pieces,
     )?;
-    if covered != n {
-        return Err(format!("leaves hold {covered} triangles, the mesh has {n}"));
+    if covered != refs {
+        return Err(format!(
+            "leaves hold {covered} triangles, the tree has {refs}"
+        ));
+    }
+    if let Some(pieces) = pieces {
+        crate::cover::check_references(mesh, pieces)?;
     }
     if interior != bvh.nodes.len() {
         return Err(format!("{interior} nodes reachable of {}", bvh.nodes.len()));
@@ -57,15 +70,16 @@ pub(crate) fn validate(bvh: &Bvh, mesh: &TriangleMesh) -> Result<(), String> {
 }
 
 /// Depth-first from `r`, whose box is `bounds`: leaves contain their triangles and tile the
-/// triangle array in order; children's boxes lie inside their parent's.
+/// triangle array in order; children's boxes lie inside their parent's. With `pieces` (spatial
+/// splits), a leaf's triangles are noted with its box instead, and none may repeat in it.
 fn walk(
     bvh: &Bvh,
     mesh: &TriangleMesh,
     r: ChildRef,
     bounds: &raybench_geom::Aabb,
     depth: usize,
-    covered: &mut usize,
-    interior: &mut usize,
+    (covered, interior): (&mut usize, &mut usize),
+    pieces: &mut Option<Vec<(u32, raybench_geom::Aabb)>>,
 ) -> Result<(), String> {
     if depth >= MAX_DEPTH {
         return Err(format!("depth {depth} exceeds the stack size {MAX_DEPTH}"));
@@ -82,7 +96,12 @@ fn walk(
                 .prim_ids
                 .get(i)
                 .ok_or(format!("leaf at {first} runs past the triangles"))?;
-            if !bounds.contains_box(&mesh.triangle(id as usize).bounds()) {
+            if let Some(pieces) = pieces.as_mut() {
+                if bvh.prim_ids[first..i].contains(&id) {
+                    return Err(format!("triangle {id} twice in the leaf at {first}"));
+                }
+                pieces.push((id, *bounds));
+            } else if !bounds.contains_box(&mesh.triangle(id as usize).bounds()) {
                 return Err(format!("leaf box does not contain triangle {id}"));
             }
         }
@@ -112,8 +131,8 @@ fn walk(
             node.child[i],
             &child,
             depth + 1,
-            covered,
-            interior,
+            (&mut *covered, &mut *interior),
+            pieces,
         )?;
     }
     Ok(())

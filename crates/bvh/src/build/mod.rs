@@ -22,8 +22,11 @@
 
 mod prim;
 pub mod reinsert;
+mod spatial;
 mod split;
 
+pub use spatial::{MAX_SPATIAL_BINS, SpatialSplits};
+pub(crate) use spatial::{SpatialReport, spatial_stats};
 pub use split::MAX_BINS;
 
 use crate::node::{ChildRef, MAX_DEPTH, Node};
@@ -45,6 +48,8 @@ pub(crate) struct Flat {
     pub refs: Vec<PrimRef>,
     pub root: ChildRef,
     pub root_bounds: Aabb,
+    /// What spatial splits did, when the build used them.
+    pub spatial: Option<SpatialReport>,
 }
 
 /// Peak bytes per triangle of a build: its 32-byte record, up to one 64-byte node in the
@@ -54,7 +59,11 @@ const PEAK_BYTES_PER_TRIANGLE: u64 = 32 + 2 * 64 + 4 + 48;
 
 pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, BuildError> {
     let n = mesh.len();
-    let needed_bytes = n as u64 * PEAK_BYTES_PER_TRIANGLE;
+    // Duplicated references take a record, a leaf slot and a triangle copy each.
+    let growth = params
+        .spatial_splits
+        .map_or(0.0, |s| s.max_reference_growth.max(0.0) as f64);
+    let needed_bytes = (n as f64 * (1.0 + growth)) as u64 * PEAK_BYTES_PER_TRIANGLE;
     if needed_bytes > params.memory_limit_bytes {
         return Err(BuildError::TooLarge {
             needed_bytes,
@@ -72,7 +81,17 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
             refs: Vec::new(),
             root: ChildRef::default(),
             root_bounds: Aabb::EMPTY,
+            spatial: params.spatial_splits.map(|_| SpatialReport::default()),
         });
+    }
+    if let Some(s) = &params.spatial_splits {
+        if !(2..=MAX_SPATIAL_BINS as u32).contains(&s.spatial_bins) {
+            return Err(BuildError::Unsupported(format!(
+                "spatial_bins from 2 to {MAX_SPATIAL_BINS} (got {})",
+                s.spatial_bins
+            )));
+        }
+        return Ok(spatial::build(mesh, params, s));
     }
     let mut refs: Vec<PrimRef> = (0..n)
         .into_par_iter()
@@ -89,6 +108,7 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
         nodes,
         root,
         root_bounds,
+        spatial: None,
     })
 }
 

@@ -40,7 +40,12 @@ impl Split {
 /// The SAH cost of splitting a range with box area `parent` into `(area, count)` halves,
 /// relative to intersecting every triangle (MacDonald and Booth 1990). Areas may be half
 /// areas: only their ratios matter.
-fn split_cost(p: &BvhParams, parent: f64, left: (f64, usize), right: (f64, usize)) -> f64 {
+pub(crate) fn split_cost(
+    p: &BvhParams,
+    parent: f64,
+    left: (f64, usize),
+    right: (f64, usize),
+) -> f64 {
     p.traversal_cost as f64
         + p.intersection_cost as f64 * (left.0 * blocks(p, left.1) + right.0 * blocks(p, right.1))
             / parent
@@ -60,7 +65,7 @@ fn blocks(p: &BvhParams, n: usize) -> f64 {
 
 /// Whether the best split is worth taking: always when the range is too big for a leaf,
 /// otherwise only when it is cheaper than intersecting every triangle.
-fn worth_splitting(p: &BvhParams, n: usize, best_cost: f64) -> bool {
+pub(crate) fn worth_splitting(p: &BvhParams, n: usize, best_cost: f64) -> bool {
     n > p.max_leaf_size as usize || best_cost < p.intersection_cost as f64 * blocks(p, n)
 }
 

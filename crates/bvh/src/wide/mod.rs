@@ -74,6 +74,8 @@ pub struct BvhWide<const W: usize> {
     /// Leaf triangles, four to a `Tri4`, each lane with its mesh index
     /// ([`NO_PRIM`](raybench_geom::NO_PRIM) unused).
     tri4s: Vec<Tri4>,
+    /// What spatial splits did (`None` without them).
+    spatial: Option<build::SpatialReport>,
     /// The mesh as built, for closest-point queries (exact vertices).
     mesh: Arc<TriangleMesh>,
     #[cfg(target_arch = "x86_64")]
@@ -182,6 +184,7 @@ impl<const W: usize> Accel for BvhWide<W> {
             root,
             root_bounds: flat.root_bounds,
             tri4s,
+            spatial: flat.spatial,
             mesh,
             #[cfg(target_arch = "x86_64")]
             avx2: match params.node_simd {
@@ -203,6 +206,7 @@ impl<const W: usize> Accel for BvhWide<W> {
     /// name.
     fn name(&self) -> &str {
         match (W, self.params.coherent_packets) {
+            (8, false) if self.params.binary.spatial_splits.is_some() => "bvh8-sbvh",
             (4, _) => "bvh4-binned",
             (_, false) if self.params.binary.reinsertion.is_some() => "bvh8-reinsert",
             (_, false) => "bvh8-binned",
@@ -276,7 +280,9 @@ impl<const W: usize> Accel for BvhWide<W> {
     }
 
     fn build_stats(&self) -> BuildStats {
-        self.measure()
+        let mut stats = self.measure();
+        build::spatial_stats(&mut stats, self.spatial, self.mesh.len());
+        stats
     }
 
     fn memory(&self) -> Memory {

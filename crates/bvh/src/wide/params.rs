@@ -52,6 +52,15 @@ impl WideParams {
     }
 }
 
+impl WideParams {
+    /// The 8-wide defaults over a binary tree built with spatial splits (`bvh8-sbvh`).
+    pub fn sbvh() -> WideParams {
+        let mut p = WideParams::for_width(8);
+        p.binary.spatial_splits = Some(crate::SpatialSplits::default());
+        p
+    }
+}
+
 impl Default for WideParams {
     fn default() -> Self {
         WideParams {

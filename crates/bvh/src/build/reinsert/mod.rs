@@ -96,7 +96,9 @@ pub(crate) fn optimize(flat: Flat, p: &BvhParams) -> (Flat, Option<ReinsertStats
     };
     run(&mut tree, &knobs, &mut stats);
     stats.sah_after = sah(&tree);
-    (tree.into_flat(&flat.refs), Some(stats))
+    let mut out = tree.into_flat(&flat.refs);
+    out.spatial = flat.spatial;
+    (out, Some(stats))
 }
 
 fn interior_area(t: &Tree) -> f64 {

@@ -235,6 +235,8 @@ impl Tree {
             refs: out,
             root,
             root_bounds: to_aabb(&self.bounds[self.root as usize]),
+            // The caller carries over what the builder reported.
+            spatial: None,
         }
     }
 }

@@ -1,0 +1,342 @@
+//! Split BVH (SBVH; Stich, Friedrich and Dietrich 2009, "Spatial Splits in Bounding Volume
+//! Hierarchies"): at each node the binned object split is weighed against a spatial split, a
+//! plane that cuts the triangles crossing it into one reference per side, each with the box of
+//! its piece ([`bins`], [`divide`]). Where long or diagonal triangles make the object split's
+//! children overlap, cutting them shrinks the boxes a ray must enter, at the price of more
+//! references (a triangle may be tested twice on a ray) and a slower build. Two limits keep
+//! the price down: a spatial split is only tried where the object split's children overlap by
+//! more than `alpha` × the root's area, and the references may grow to at most
+//! `1 + max_reference_growth` times the triangles, a budget shared top-down between the
+//! children in proportion to their references (as Embree's spatial-split builder shares its
+//! extra space), so the tree does not depend on which task builds what first. Below a node
+//! whose own area is under the `alpha` limit (no children of it can overlap more) or whose
+//! budget is spent, the plain binned builder takes over the range. Caveats: a duplicated
+//! triangle is tested once per reference a ray reaches, with the same answer (no mailbox: the
+//! closest hit does not change); a ray finds a triangle only because its pieces' boxes cover
+//! it, which the outward rounding of the cuts ([`chop`]) guarantees and the validators check;
+//! and the choice is greedy, node by node, so on scenes whose few huge triangles span
+//! everything (the ground of `city` and `grass`) the tree can come out no better than the
+//! binned one.
+
+mod bins;
+pub(crate) mod chop;
+mod divide;
+
+pub use bins::MAX_SPATIAL_BINS;
+
+use super::split::{PARALLEL_BINNING, Scratch, Split, binned_split, leaf_beats_any_split};
+use super::split::{split_cost, worth_splitting};
+use super::{Flat, Part, Ranged, build_local, build_part, interior};
+use crate::BvhParams;
+use crate::build::PrimRef;
+use crate::node::{ChildRef, MAX_DEPTH, Node};
+use bins::{SlabBins, best_spatial_split};
+use divide::{Divided, divide};
+use raybench_geom::{Aabb, TriangleMesh};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// The knobs of spatial splits (`BvhParams::spatial_splits`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SpatialSplits {
+    /// A spatial split is tried at a node only when the boxes of its best object split's
+    /// children overlap by more than this fraction of the root box's surface area (the
+    /// paper's α; 1e-5 there). 1e-4: against 1e-5, the same SAH cost within 0.7 % on Sponza,
+    /// the dragon, conference and hair, for 20–40 % less build time; 1e-3 builds the dragon
+    /// in half the time again but costs 1.5 % SAH on conference (`examples/sbvh_tune`,
+    /// 2 threads, 2026-11-26, with `intersection_cost` at 0.15).
+    pub alpha: f32,
+    /// The references may number at most `(1 + max_reference_growth)` × the triangles. 0.5:
+    /// hair uses all of it (SAH 8835 binned, 8130 at 0.25, 7389 at 0.5, 6870 at 1.0, build
+    /// 462, 403 and 685 ms); the real scenes stop short of it (growth 1.02 to 1.21; measured
+    /// with `intersection_cost` at 0.15).
+    pub max_reference_growth: f32,
+    /// The SAH cost of a triangle test (a node step costing 1) in the choice between the object
+    /// and the spatial split, and between a spatial split and a leaf; the object splits keep
+    /// the binary builder's `intersection_cost`. 1: with the wide tree's 0.15 per triangle
+    /// slot, spatial splits never divide a node the object split leaves as a leaf, and random
+    /// rays test 8.18 → 6.52 triangles on Sponza (binned → SBVH) and visit 4.66 → 3.62 nodes;
+    /// with 1, 3.86 triangles and 3.87 nodes; grass 6.49 → 7.55 tests with 0.15 but 4.68 with
+    /// 1 (nodes 4.95 → 4.92 and 5.28) (`examples/sbvh_tune`, 20,000 random rays, 2026-11-26).
+    pub intersection_cost: f32,
+    /// Slabs per axis in the spatial split's binning (at most [`MAX_SPATIAL_BINS`]). 16: on
+    /// hair (50,000 triangles) the same SAH cost as 32 (7389 against 7394) in 403 ms instead of
+    /// 644; 8 gives 7399 in 302 ms (`examples/sbvh_tune`, 2 threads, 2026-11-26, with
+    /// `intersection_cost` at 0.15).
+    pub spatial_bins: u32,
+}
+
+impl Default for SpatialSplits {
+    fn default() -> Self {
+        SpatialSplits {
+            alpha: 1e-4,
+            max_reference_growth: 0.5,
+            spatial_bins: 16,
+            intersection_cost: 1.0,
+        }
+    }
+}
+
+/// What a build with spatial splits did, for the report.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct SpatialReport {
+    pub spatial_splits: u64,
+}
+
+/// The fixed inputs of every node.
+struct Ctx<'a> {
+    p: &'a BvhParams,
+    s: &'a SpatialSplits,
+    mesh: &'a TriangleMesh,
+    /// `alpha` × the root's half area.
+    min_overlap: f64,
+    /// The binary builder's knobs with the spatial splits' `intersection_cost`.
+    priced: BvhParams,
+}
+
+/// A subtree as the spatial builder returns it, before flattening.
+enum Tree {
+    Leaf(Vec<PrimRef>),
+    Node {
+        bounds: [Aabb; 2],
+        spatial: bool,
+        children: Box<(Tree, Tree)>,
+    },
+    /// A range the binned builder built, its leaves numbered from 0 within `refs`.
+    Binned {
+        part: Part,
+        refs: Vec<PrimRef>,
+    },
+}
+
+/// Per-task working memory.
+struct Work {
+    binned: Box<Scratch>,
+    slabs: Box<SlabBins>,
+}
+
+impl Work {
+    fn new() -> Work {
+        Work {
+            binned: Scratch::new(),
+            slabs: SlabBins::new(),
+        }
+    }
+}
+
+/// Builds the tree of a non-empty mesh with spatial splits.
+pub(crate) fn build(mesh: &TriangleMesh, p: &BvhParams, s: &SpatialSplits) -> Flat {
+    let n = mesh.len();
+    let refs: Vec<PrimRef> = (0..n)
+        .into_par_iter()
+        .map(|i| PrimRef::new(&mesh.triangle(i).bounds(), i as u32))
+        .collect();
+    let whole = Ranged::of(&refs, PARALLEL_BINNING);
+    let ctx = Ctx {
+        p,
+        s,
+        mesh,
+        min_overlap: s.alpha as f64 * whole.bounds.half_area(),
+        priced: BvhParams {
+            intersection_cost: s.intersection_cost,
+            ..p.clone()
+        },
+    };
+    let budget = (n as f64 * s.max_reference_growth.max(0.0) as f64) as usize;
+    let tree = ctx.node(refs, whole, 0, budget, &mut Work::new());
+    let mut out = Flat {
+        nodes: Vec::with_capacity(n),
+        refs: Vec::with_capacity(n),
+        root: ChildRef::default(),
+        root_bounds: whole.bounds.to_aabb(),
+        spatial: Some(SpatialReport::default()),
+    };
+    out.root = tree.flatten(&mut out);
+    out
+}
+
+impl Ctx<'_> {
+    fn node(
+        &self,
+        refs: Vec<PrimRef>,
+        r: Ranged,
+        depth: usize,
+        budget: usize,
+        w: &mut Work,
+    ) -> Tree {
+        let (p, n) = (self.p, refs.len());
+        if budget == 0 || r.bounds.half_area() <= self.min_overlap {
+            return self.binned(refs, r, depth, w);
+        }
+        if n == 1 || depth + 1 >= MAX_DEPTH || leaf_beats_any_split(p, n) {
+            return Tree::Leaf(refs);
+        }
+        let mut refs = refs;
+        let object = binned_split(&mut refs, &r, p, &mut w.binned);
+        let parent = r.bounds.half_area();
+        let q = &self.priced;
+        let object_cost = object.map(|o| {
+            let (l, r) = (
+                (o.left.bounds.half_area(), o.mid),
+                (o.right.bounds.half_area(), n - o.mid),
+            );
+            split_cost(q, parent, l, r)
+        });
+        let overlap = object.map_or(f64::INFINITY, |o| {
+            let both = chop::intersect(&o.left.bounds, &o.right.bounds);
+            if chop::is_empty(&both) {
+                0.0
+            } else {
+                both.half_area()
+            }
+        });
+        if overlap > self.min_overlap
+            && let Some(s) = best_spatial_split(
+                &refs,
+                self.mesh,
+                &r.bounds,
+                q,
+                self.s.spatial_bins as usize,
+                budget,
+                &mut w.slabs,
+            )
+            && object_cost.is_none_or(|c| s.cost < c)
+            && worth_splitting(q, n, s.cost)
+            && let Some(d) = divide(&refs, self.mesh, &s)
+        {
+            drop(refs);
+            return self.children(d, budget, depth, true, w);
+        }
+        let split = match object {
+            Some(o) => o,
+            None if n <= p.max_leaf_size as usize => return Tree::Leaf(refs),
+            // Centroids indistinguishable and no plane worth cutting: halves as they are.
+            None => Split::at(&refs, n / 2),
+        };
+        let right = refs.split_off(split.mid);
+        let d = Divided {
+            left: refs,
+            right,
+            duplicates: 0,
+        };
+        self.children(d, budget, depth, false, w)
+    }
+
+    /// Builds both children of a split, sharing the budget left in proportion to their
+    /// references (on two rayon tasks above the parallel threshold).
+    fn children(
+        &self,
+        d: Divided,
+        budget: usize,
+        depth: usize,
+        spatial: bool,
+        w: &mut Work,
+    ) -> Tree {
+        let (nl, nr) = (d.left.len(), d.right.len());
+        let rest = budget.saturating_sub(d.duplicates);
+        let left_budget = (rest as u128 * nl as u128 / (nl + nr) as u128) as usize;
+        let right_budget = rest - left_budget;
+        let (left, right) = (
+            Ranged::of(&d.left, PARALLEL_BINNING),
+            Ranged::of(&d.right, PARALLEL_BINNING),
+        );
+        let bounds = [left.bounds.to_aabb(), right.bounds.to_aabb()];
+        let children = if nl + nr > self.p.parallel_threshold as usize {
+            rayon::join(
+                || self.node(d.left, left, depth + 1, left_budget, w),
+                || self.node(d.right, right, depth + 1, right_budget, &mut Work::new()),
+            )
+        } else {
+            let a = self.node(d.left, left, depth + 1, left_budget, w);
+            (a, self.node(d.right, right, depth + 1, right_budget, w))
+        };
+        Tree::Node {
+            bounds,
+            spatial,
+            children: Box::new(children),
+        }
+    }
+
+    /// The plain binned builder over `refs`, where no spatial split can be tried.
+    fn binned(&self, mut refs: Vec<PrimRef>, r: Ranged, depth: usize, w: &mut Work) -> Tree {
+        let part = if refs.len() > self.p.parallel_threshold as usize {
+            build_part(self.p, &mut refs, 0, r, depth)
+        } else {
+            let mut nodes = Vec::new();
+            let root = build_local(self.p, &mut refs, 0, r, depth, &mut nodes, &mut w.binned);
+            Part::Local { nodes, root }
+        };
+        Tree::Binned { part, refs }
+    }
+}
+
+impl Tree {
+    /// Appends this subtree's nodes and references to `out` depth-first; returns its root.
+    fn flatten(self, out: &mut Flat) -> ChildRef {
+        match self {
+            Tree::Leaf(refs) => {
+                let r = ChildRef {
+                    index: out.refs.len() as u32,
+                    count: refs.len() as u32,
+                };
+                out.refs.extend(refs);
+                r
+            }
+            Tree::Node {
+                bounds,
+                spatial,
+                children,
+            } => {
+                if spatial && let Some(s) = out.spatial.as_mut() {
+                    s.spatial_splits += 1;
+                }
+                let at = out.nodes.len();
+                out.nodes.push(Node::new(
+                    [&bounds[0], &bounds[1]],
+                    [ChildRef::default(); 2],
+                ));
+                let (a, b) = *children;
+                let a = a.flatten(out);
+                let b = b.flatten(out);
+                out.nodes[at].child = [a, b];
+                interior(at)
+            }
+            Tree::Binned { part, refs } => {
+                // The binned builder numbered its leaves from 0: shift them to where its
+                // references land.
+                let (first_node, offset) = (out.nodes.len(), out.refs.len() as u32);
+                let mut root = part.flatten(&mut out.nodes);
+                for node in &mut out.nodes[first_node..] {
+                    for c in node.child.iter_mut().filter(|c| c.is_leaf()) {
+                        c.index += offset;
+                    }
+                }
+                if root.is_leaf() {
+                    root.index += offset;
+                }
+                out.refs.extend(refs);
+                root
+            }
+        }
+    }
+}
+
+/// Adds to a tree's statistics what spatial splits did: the splits taken and the references
+/// per triangle (1 without duplicates). Nothing for a tree built without them.
+pub(crate) fn spatial_stats(
+    stats: &mut raybench_accel::BuildStats,
+    report: Option<SpatialReport>,
+    triangles: usize,
+) {
+    let Some(r) = report else { return };
+    stats
+        .extra
+        .insert("spatial_splits".into(), r.spatial_splits as f64);
+    stats.extra.insert(
+        "reference_growth".into(),
+        stats.refs as f64 / triangles.max(1) as f64,
+    );
+}
+
+#[cfg(test)]
+mod tests;

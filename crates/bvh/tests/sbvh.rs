@@ -1,0 +1,164 @@
+//! Spatial splits (`bvh8-sbvh`, and the binary tree with the same knob): the shared suite, a
+//! scene where spatial splits must pay off, the reference budget, and thread independence.
+
+use raybench_accel::{Accel, BuildStats, Counters};
+use raybench_bvh::{Bvh, Bvh8, BvhParams, SpatialSplits, WideParams};
+use raybench_testkit::{Case, check_case, conformance};
+use std::sync::Arc;
+
+fn sbvh(growth: f32) -> WideParams {
+    let mut p = WideParams::sbvh();
+    p.binary.spatial_splits = Some(SpatialSplits {
+        max_reference_growth: growth,
+        ..SpatialSplits::default()
+    });
+    p
+}
+
+#[test]
+fn binary_sbvh_conforms() {
+    for params in [
+        BvhParams::sbvh(),
+        BvhParams {
+            max_leaf_size: 1,
+            ..BvhParams::sbvh()
+        },
+    ] {
+        let counts = conformance::<Bvh>(&params, &|b, m| b.validate(m));
+        assert_eq!(counts.mismatch, 0, "{params:?}");
+        assert!(counts.exact > 10_000, "{counts:?}");
+    }
+}
+
+#[test]
+fn wide_sbvh_conforms() {
+    for params in [WideParams::sbvh(), sbvh(2.0)] {
+        let counts = conformance::<Bvh8>(&params, &|b, m| b.validate(m));
+        assert_eq!(counts.mismatch, 0, "{params:?}");
+        assert!(counts.exact > 10_000, "{counts:?}");
+    }
+}
+
+#[test]
+fn wide_sbvh_conforms_on_the_shared_scenes() {
+    let checked =
+        raybench_testkit::conformance_on_shared_scenes::<Bvh8>(&WideParams::sbvh(), &|b, m| {
+            b.validate(m)
+        });
+    eprintln!("real scenes checked: {checked}");
+}
+
+/// Hair (long thin fibres at every angle) and a scene of long diagonal slivers: seeded rays
+/// against brute force, with validation.
+#[test]
+fn sbvh_conforms_on_fibres() {
+    for (spec, seed) in [("hair:triangles=5000", 3), ("soup:triangles=2000", 11)] {
+        let mesh = raybench_testkit::generated(spec, seed);
+        let mut rays = raybench_testkit::random_rays_in(&mesh.bounds().enlarged(0.1), 4000, seed);
+        rays.extend(raybench_testkit::centroid_rays(&mesh, 4000, seed ^ 1));
+        let case = Case {
+            name: spec.to_string(),
+            seed,
+            mesh,
+            rays,
+        };
+        let counts = check_case::<Bvh8>(&case, &WideParams::sbvh(), &|b, m| b.validate(m))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(counts.mismatch, 0, "{spec}: {counts:?}");
+        let counts = check_case::<Bvh>(&case, &BvhParams::sbvh(), &|b, m| b.validate(m))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(counts.mismatch, 0, "{spec}: {counts:?}");
+    }
+}
+
+fn stats(mesh: &Arc<raybench_geom::TriangleMesh>, params: &WideParams) -> BuildStats {
+    let bvh = Bvh8::build(mesh.clone(), params).expect("builds");
+    bvh.validate(mesh).expect("validates");
+    bvh.build_stats()
+}
+
+/// On hair, spatial splits are taken, they lower the SAH cost below the binned tree's, and the
+/// references grow, but no further than the budget.
+#[test]
+fn spatial_splits_pay_on_hair_within_the_budget() {
+    let mesh = raybench_testkit::generated("hair", 1);
+    let n = mesh.len() as f64;
+    let binned = stats(&mesh, &WideParams::for_width(8));
+    assert!(!binned.extra.contains_key("spatial_splits"));
+    for growth in [0.1, 0.5] {
+        let s = stats(&mesh, &sbvh(growth));
+        let context = format!("growth {growth}: binned {binned:?}, sbvh {s:?}");
+        assert!(s.extra["spatial_splits"] > 0.0, "{context}");
+        assert!(s.sah_cost.unwrap() < binned.sah_cost.unwrap(), "{context}");
+        let refs = s.refs as f64;
+        assert!(refs > n && refs <= n * (1.0 + growth as f64), "{context}");
+        assert_eq!(s.extra["reference_growth"], refs / n, "{context}");
+    }
+}
+
+/// With no budget for duplicates the tree is the binned tree.
+#[test]
+fn no_budget_builds_the_binned_tree() {
+    let mesh = raybench_testkit::generated("hair", 2);
+    let a = Bvh8::build(mesh.clone(), &sbvh(0.0)).expect("builds");
+    let b = Bvh8::build(mesh.clone(), &WideParams::for_width(8)).expect("builds");
+    assert!(a.nodes() == b.nodes() && a.tri4s() == b.tri4s());
+    assert_eq!(a.build_stats().extra["spatial_splits"], 0.0);
+}
+
+/// The tree, its references and every ray's answer and counters are the same on one and two
+/// threads (the budget is shared top-down, never first come, first served).
+#[test]
+fn sbvh_is_the_same_with_one_and_two_threads() {
+    for spec in ["hair", "soup:triangles=20000"] {
+        let mesh = raybench_testkit::generated(spec, 5);
+        let build = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a thread pool");
+            pool.install(|| Bvh8::build(mesh.clone(), &WideParams::sbvh()).expect("builds"))
+        };
+        let (one, two) = (build(1), build(2));
+        assert!(
+            one.nodes().len() > 100,
+            "{spec}: big enough to build in parallel"
+        );
+        assert!(one.build_stats().extra["spatial_splits"] > 0.0, "{spec}");
+        assert!(one.nodes() == two.nodes(), "{spec}: nodes differ");
+        assert!(one.tri4s() == two.tri4s(), "{spec}: Tri4s differ");
+        for ray in raybench_testkit::random_rays_in(&mesh.bounds(), 3000, 9) {
+            let (mut ca, mut cb) = (Counters::default(), Counters::default());
+            assert_eq!(
+                one.intersect_counted(&ray, &mut ca),
+                two.intersect_counted(&ray, &mut cb)
+            );
+            assert_eq!(ca, cb);
+        }
+    }
+}
+
+/// Knobs out of range are refused, and the memory estimate counts the reference budget.
+#[test]
+fn bad_bins_are_refused_and_the_budget_is_in_the_estimate() {
+    use raybench_accel::BuildError;
+    let mesh = raybench_testkit::generated("soup:triangles=2000", 1);
+    for bins in [0, 1, 65] {
+        let mut p = BvhParams::sbvh();
+        p.spatial_splits.as_mut().unwrap().spatial_bins = bins;
+        assert!(matches!(
+            Bvh::build(mesh.clone(), &p),
+            Err(BuildError::Unsupported(_))
+        ));
+    }
+    let needed = |growth: f32| {
+        let mut p = BvhParams::sbvh();
+        p.memory_limit_bytes = 1;
+        p.spatial_splits.as_mut().unwrap().max_reference_growth = growth;
+        match Bvh::build(mesh.clone(), &p) {
+            Err(BuildError::TooLarge { needed_bytes, .. }) => needed_bytes,
+            other => panic!("{other:?}"),
+        }
+    };
+    assert_eq!(needed(1.0), 2 * needed(0.0));
+}
