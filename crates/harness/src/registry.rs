@@ -2,7 +2,7 @@
 //! (see README, "Adding a structure").
 
 use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
-use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, BvhQuantized, NodeFormat, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
 use raybench_grid::{Grid, Grid2, Grid2Params, GridParams, SkipGrid, SkipGridParams};
@@ -157,6 +157,15 @@ pub fn registry() -> Vec<StructureEntry> {
             None,
             |_| WideParams {
                 coherent_packets: true,
+                ..WideParams::for_width(8)
+            },
+        ),
+        register::<BvhQuantized>(
+            "bvh8-compressed",
+            "the bvh8-binned tree (same collapse, same Tri4 leaves, same walk) with quantized nodes: per node and axis an f32 origin and a power-of-two step, each child plane one byte rounded outward, 128 bytes a node instead of 256; decoded with AVX2 before the same 8-lane box test",
+            None,
+            |_| WideParams {
+                node_format: NodeFormat::Quantized,
                 ..WideParams::for_width(8)
             },
         ),
