@@ -1,78 +1,102 @@
-//! Decoding a quantized node for the float kernels, and the AVX2 batch loops.
+//! The quantized node test, and the AVX2 batch loops.
 //!
-//! A node is decoded to the float node's planes ([`WideNode`]) and handed to the float
-//! node kernel, so the slab arithmetic is the float tree's, lane for lane: only the planes
-//! differ, and every decoded plane lies outside its float plane, so a ray that enters a float
-//! box enters its quantized box (subtraction and multiplication by the same inverse are
-//! monotonic). With AVX2 the decode is one widening load (8 bytes to 8 lanes), one integer to
-//! float conversion, a multiply by the power-of-two step (exact) and an add per plane; inlined
-//! into the walk, the decoded planes stay in registers.
+//! The arithmetic is the float node test's on decoded planes, lane for lane: every decoded
+//! plane lies outside its float plane, and subtracting the origin and multiplying by the same
+//! inverse direction are monotonic, so a ray that enters a float box enters its quantized box.
+//! With AVX2 each plane row is decoded in registers — one widening load (8 bytes to 8 lanes),
+//! one integer-to-float conversion, a multiply by the power-of-two step (exact) and an add —
+//! right before the slab test; the portable kernel decodes the whole node to floats and runs
+//! the float SSE test.
 
 use super::BvhQuantized;
 use super::node::{QNode, QWIDTH};
-use crate::wide::WideNode;
 use crate::wide::kernels::{NodeKernel, SseNodes};
 
-/// A node kernel that can also test quantized nodes, by decoding them first.
+/// A node kernel that can also test quantized nodes.
 pub(crate) trait QuantKernel: NodeKernel<QWIDTH> {
-    /// The node's planes as floats, bit for bit [`QNode::decode_scalar`] in the used slots
-    /// (unused slots are masked off by the walk, whatever they decode to).
-    fn decode(self, n: &QNode) -> WideNode<QWIDTH>;
+    /// The float kernel's slab test on the node's decoded planes (bit for bit
+    /// [`QNode::decode_scalar`]'s): entry distances, and the mask of the used slots entered
+    /// within `[t_min, t_max]`.
+    fn test_quantized(
+        self,
+        ray: &Self::Ray,
+        n: &QNode,
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; QWIDTH]);
 }
 
+/// The portable kernel decodes the node to floats and runs the float node test on them.
 impl QuantKernel for SseNodes {
     #[inline(always)]
-    fn decode(self, n: &QNode) -> WideNode<QWIDTH> {
-        n.decode_scalar()
+    fn test_quantized(
+        self,
+        ray: &Self::Ray,
+        n: &QNode,
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; QWIDTH]) {
+        let (mask, entry) = self.test(ray, &n.decode_scalar(), t_min, t_max);
+        (mask & n.used_mask(), entry)
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::{BvhQuantized, QNode, QWIDTH, QuantKernel, WideNode};
-    use crate::wide::avx2::Avx2Nodes;
+    use super::{BvhQuantized, QNode, QWIDTH, QuantKernel};
+    use crate::wide::avx2::{Avx2Nodes, Avx2Ray};
     use crate::wide::walk::Stack;
     use raybench_accel::{Hit, NoCount};
     use raybench_geom::Ray;
     use std::arch::x86_64::*;
 
-    /// One plane row: 8 bytes widened to 8 lanes, `origin + q * step`.
+    /// One plane row in registers: 8 bytes widened to 8 lanes, `origin + q * step`.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn decode_row(row: &[u8; QWIDTH], origin: __m256, step: __m256) -> [f32; QWIDTH] {
-        let mut out = [0.0f32; QWIDTH];
-        // SAFETY: `row` is 8 readable bytes (`loadl_epi64` reads exactly 8, unaligned) and
-        // `out` 8 writable f32s (`storeu` has no alignment requirement).
-        unsafe {
-            let bytes = _mm_loadl_epi64(row.as_ptr().cast());
-            let q = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes));
-            let plane = _mm256_add_ps(origin, _mm256_mul_ps(q, step));
-            _mm256_storeu_ps(out.as_mut_ptr(), plane);
-        }
-        out
+    fn plane(row: &[u8; QWIDTH], origin: __m256, step: __m256) -> __m256 {
+        // SAFETY: `row` is 8 readable bytes; `loadl_epi64` reads exactly 8, unaligned.
+        let bytes = unsafe { _mm_loadl_epi64(row.as_ptr().cast()) };
+        let q = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes));
+        _mm256_add_ps(origin, _mm256_mul_ps(q, step))
     }
 
+    /// The float AVX2 node test (`test_octs`) on planes decoded in registers: per axis the
+    /// near and far rows (chosen by the ray's direction signs) decoded, then the same
+    /// subtract, multiply, `max`/`min` and ordered compare, lane for lane.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn decode_avx2(n: &QNode) -> WideNode<QWIDTH> {
-        let mut planes = [[[0.0f32; QWIDTH]; 2]; 3];
-        for (axis, p) in planes.iter_mut().enumerate() {
-            let origin = _mm256_set1_ps(n.origin[axis]);
-            let step = _mm256_set1_ps(super::super::node::step(n.exp[axis]));
-            p[0] = decode_row(&n.q[axis][0], origin, step);
-            p[1] = decode_row(&n.q[axis][1], origin, step);
+    fn test_avx2(r: &Avx2Ray, n: &QNode, t_min: f32, t_max: f32) -> (u32, [f32; QWIDTH]) {
+        let mut t0 = _mm256_set1_ps(t_min);
+        let mut t1 = _mm256_set1_ps(t_max);
+        for a in 0..3 {
+            let origin = _mm256_set1_ps(n.origin[a]);
+            let step = _mm256_set1_ps(super::super::node::step(n.exp[a]));
+            let near = plane(&n.q[a][r.near[a] as usize], origin, step);
+            let far = plane(&n.q[a][!r.near[a] as usize], origin, step);
+            t0 = _mm256_max_ps(
+                _mm256_mul_ps(_mm256_sub_ps(near, r.origin[a]), r.inv[a]),
+                t0,
+            );
+            t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, r.origin[a]), r.inv[a]), t1);
         }
-        WideNode {
-            planes,
-            child: n.child,
-        }
+        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32;
+        let mut entry = [0.0f32; QWIDTH];
+        // SAFETY: `entry` is 8 writable f32s; `storeu` has no alignment requirement.
+        unsafe { _mm256_storeu_ps(entry.as_mut_ptr(), t0) };
+        (mask & n.used_mask(), entry)
     }
 
     impl QuantKernel for Avx2Nodes {
         #[inline(always)]
-        fn decode(self, n: &QNode) -> WideNode<QWIDTH> {
+        fn test_quantized(
+            self,
+            ray: &Avx2Ray,
+            n: &QNode,
+            t_min: f32,
+            t_max: f32,
+        ) -> (u32, [f32; QWIDTH]) {
             // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.
-            unsafe { decode_avx2(n) }
+            unsafe { test_avx2(ray, n, t_min, t_max) }
         }
     }
 
@@ -168,25 +192,60 @@ mod avx2 {
     mod tests {
         use super::*;
 
-        /// The AVX2 decode is the scalar decode bit for bit in every used slot.
+        /// The AVX2 quantized node test answers as the portable one (decode, then the SSE
+        /// float test), mask and entry distances bit for bit, on the extreme sample nodes and
+        /// rays in every direction octant, axis-parallel ones included.
         #[test]
-        fn avx2_decode_matches_scalar() {
+        fn avx2_test_matches_the_portable_test() {
+            use crate::wide::kernels::{NodeKernel, SseNodes};
+            use raybench_geom::Vec3;
             let Some(k) = Avx2Nodes::detect(false) else {
                 return;
             };
+            let mut rng = 0x9e3779b97f4a7c15u64;
+            let mut next = move || {
+                rng ^= rng << 13;
+                rng ^= rng >> 7;
+                rng ^= rng << 17;
+                (rng >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+            };
+            let mut checked = 0;
             for n in super::super::super::node::tests::sample_nodes() {
-                let (a, b) = (k.decode(&n), n.decode_scalar());
-                for i in 0..n.children() {
-                    assert_eq!(
-                        a.child_bounds(i).min.to_array().map(f32::to_bits),
-                        b.child_bounds(i).min.to_array().map(f32::to_bits)
-                    );
-                    assert_eq!(
-                        a.child_bounds(i).max.to_array().map(f32::to_bits),
-                        b.child_bounds(i).max.to_array().map(f32::to_bits)
-                    );
+                for i in 0..2000 {
+                    // Aimed at a point of one child from around it, or along an axis (±0 in
+                    // the other components) every sixth ray.
+                    let b = n.child_bounds(i % n.children());
+                    let at = |t: f32| b.min + (b.max - b.min) * (t * 0.5 + 0.5);
+                    let target = at(next());
+                    let reach = (b.max - b.min).max_element().max(1.0) * 4.0;
+                    let o = target + Vec3::new(next(), next(), next()) * reach;
+                    let mut dir = target - o;
+                    if i % 6 == 0 {
+                        let keep = i % 3;
+                        let zero = if i % 12 == 0 { 0.0 } else { -0.0 };
+                        dir = Vec3::from_array(std::array::from_fn(|a| {
+                            if a == keep { dir[a] } else { zero }
+                        }));
+                    }
+                    if dir == Vec3::ZERO || !dir.is_finite() || !o.is_finite() {
+                        continue;
+                    }
+                    let ray = Ray::infinite(o, dir);
+                    let (sse, avx) = (SseNodes, k);
+                    let (ms, es) =
+                        sse.test_quantized(&NodeKernel::<QWIDTH>::ray(sse, &ray), &n, 0.0, 1e30);
+                    let (ma, ea) =
+                        avx.test_quantized(&NodeKernel::<QWIDTH>::ray(avx, &ray), &n, 0.0, 1e30);
+                    assert_eq!(ms, ma, "{ray:?}");
+                    for lane in 0..QWIDTH {
+                        if ms & (1 << lane) != 0 {
+                            assert_eq!(es[lane].to_bits(), ea[lane].to_bits(), "{ray:?}");
+                        }
+                    }
+                    checked += ms.count_ones();
                 }
             }
+            assert!(checked > 1000, "the rays must enter children: {checked}");
         }
     }
 }

@@ -194,9 +194,10 @@ impl QNode {
         let mut planes = [[[f32::INFINITY; QWIDTH], [f32::NEG_INFINITY; QWIDTH]]; 3];
         for (axis, p) in planes.iter_mut().enumerate() {
             let (o, s) = (self.origin[axis], step(self.exp[axis]));
-            for i in 0..self.children() {
-                p[0][i] = decode(o, s, self.q[axis][0][i]);
-                p[1][i] = decode(o, s, self.q[axis][1][i]);
+            for (row, bytes) in p.iter_mut().zip(&self.q[axis]) {
+                for (plane, &q) in row.iter_mut().zip(bytes).take(self.children()) {
+                    *plane = decode(o, s, q);
+                }
             }
         }
         WideNode {

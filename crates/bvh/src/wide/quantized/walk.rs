@@ -50,8 +50,7 @@ impl BvhQuantized {
             } else {
                 c.node();
                 let n = &self.nodes[r.index as usize];
-                let (mask, entry) = kernel.test(&wide, &kernel.decode(n), t_min, best_t);
-                let mask = mask & n.used_mask();
+                let (mask, entry) = kernel.test_quantized(&wide, n, t_min, best_t);
                 if mask != 0 {
                     self.prefetch_children(n, mask);
                     r = if ANY_HIT {
