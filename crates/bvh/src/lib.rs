@@ -23,7 +23,10 @@ mod validate;
 pub mod wide;
 
 pub use node::{ChildRef, MAX_DEPTH, Node};
-pub use wide::{Bvh4, Bvh8, BvhQuantized, BvhWide, NodeFormat, NodeSimd, WideParams};
+pub use wide::{
+    Bvh4, Bvh8, Bvh8Compressed, Bvh8Compressed16, BvhQuantized, BvhWide, NodeFormat, NodeSimd,
+    WideParams,
+};
 
 use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, Walk};
 use raybench_geom::{MollerTriangle, Ray, TriangleMesh};

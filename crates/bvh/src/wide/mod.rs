@@ -46,7 +46,7 @@ mod walk;
 
 pub use node::WideNode;
 pub use params::{NodeFormat, NodeSimd, WideParams};
-pub use quantized::{BvhQuantized, node::QNode};
+pub use quantized::{Bvh8Compressed, Bvh8Compressed16, BvhQuantized, node::Plane, node::QNode};
 
 pub(crate) use node::quad;
 pub(crate) use walk::STACK;

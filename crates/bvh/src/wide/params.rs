@@ -28,8 +28,11 @@ pub enum NodeFormat {
     #[default]
     Float,
     /// One byte per plane on a per-node grid, rounded outward: 8 wide, 128 bytes a node
-    /// ([`BvhQuantized`](super::BvhQuantized), the registry's `bvh8-compressed`).
+    /// ([`Bvh8Compressed`](super::Bvh8Compressed), the registry's `bvh8-compressed`).
     Quantized,
+    /// Two bytes per plane, the same rounding: 8 wide, 192 bytes a node
+    /// ([`Bvh8Compressed16`](super::Bvh8Compressed16), the registry's `bvh8-compressed16`).
+    Quantized16,
 }
 
 /// Knobs of a wide BVH: the binary tree it is collapsed from, the node width and the node

@@ -9,30 +9,30 @@
 //! the float SSE test.
 
 use super::BvhQuantized;
-use super::node::{QNode, QWIDTH};
+use super::node::{Plane, QNode, QWIDTH};
 use crate::wide::kernels::{NodeKernel, SseNodes};
 
 /// A node kernel that can also test quantized nodes.
-pub(crate) trait QuantKernel: NodeKernel<QWIDTH> {
+pub(crate) trait QuantKernel<P: Plane>: NodeKernel<QWIDTH> {
     /// The float kernel's slab test on the node's decoded planes (bit for bit
     /// [`QNode::decode_scalar`]'s): entry distances, and the mask of the used slots entered
     /// within `[t_min, t_max]`.
     fn test_quantized(
         self,
         ray: &Self::Ray,
-        n: &QNode,
+        n: &QNode<P>,
         t_min: f32,
         t_max: f32,
     ) -> (u32, [f32; QWIDTH]);
 }
 
 /// The portable kernel decodes the node to floats and runs the float node test on them.
-impl QuantKernel for SseNodes {
+impl<P: Plane> QuantKernel<P> for SseNodes {
     #[inline(always)]
     fn test_quantized(
         self,
         ray: &Self::Ray,
-        n: &QNode,
+        n: &QNode<P>,
         t_min: f32,
         t_max: f32,
     ) -> (u32, [f32; QWIDTH]) {
@@ -43,20 +43,27 @@ impl QuantKernel for SseNodes {
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::{BvhQuantized, QNode, QWIDTH, QuantKernel};
+    use super::{BvhQuantized, Plane, QNode, QWIDTH, QuantKernel};
     use crate::wide::avx2::{Avx2Nodes, Avx2Ray};
     use crate::wide::walk::Stack;
     use raybench_accel::{Hit, NoCount};
     use raybench_geom::Ray;
     use std::arch::x86_64::*;
 
-    /// One plane row in registers: 8 bytes widened to 8 lanes, `origin + q * step`.
+    /// One plane row in registers: 8 planes of 8 or 16 bits widened to 8 lanes, `origin + q
+    /// * step`.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn plane(row: &[u8; QWIDTH], origin: __m256, step: __m256) -> __m256 {
-        // SAFETY: `row` is 8 readable bytes; `loadl_epi64` reads exactly 8, unaligned.
-        let bytes = unsafe { _mm_loadl_epi64(row.as_ptr().cast()) };
-        let q = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes));
+    fn plane<P: Plane>(row: &[P; QWIDTH], origin: __m256, step: __m256) -> __m256 {
+        let wide = if std::mem::size_of::<P>() == 1 {
+            // SAFETY: `row` is 8 readable bytes; `loadl_epi64` reads exactly 8, unaligned.
+            unsafe { _mm256_cvtepu8_epi32(_mm_loadl_epi64(row.as_ptr().cast())) }
+        } else {
+            // SAFETY: `row` is 8 `u16`s (`Plane` is sealed: `u8` or `u16`), 16 readable
+            // bytes; `loadu_si128` reads exactly 16, unaligned.
+            unsafe { _mm256_cvtepu16_epi32(_mm_loadu_si128(row.as_ptr().cast())) }
+        };
+        let q = _mm256_cvtepi32_ps(wide);
         _mm256_add_ps(origin, _mm256_mul_ps(q, step))
     }
 
@@ -65,7 +72,12 @@ mod avx2 {
     /// subtract, multiply, `max`/`min` and ordered compare, lane for lane.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn test_avx2(r: &Avx2Ray, n: &QNode, t_min: f32, t_max: f32) -> (u32, [f32; QWIDTH]) {
+    fn test_avx2<P: Plane>(
+        r: &Avx2Ray,
+        n: &QNode<P>,
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; QWIDTH]) {
         let mut t0 = _mm256_set1_ps(t_min);
         let mut t1 = _mm256_set1_ps(t_max);
         for a in 0..3 {
@@ -86,12 +98,12 @@ mod avx2 {
         (mask & n.used_mask(), entry)
     }
 
-    impl QuantKernel for Avx2Nodes {
+    impl<P: Plane> QuantKernel<P> for Avx2Nodes {
         #[inline(always)]
         fn test_quantized(
             self,
             ray: &Avx2Ray,
-            n: &QNode,
+            n: &QNode<P>,
             t_min: f32,
             t_max: f32,
         ) -> (u32, [f32; QWIDTH]) {
@@ -103,10 +115,11 @@ mod avx2 {
     /// The walk compiled for AVX2, so the decode and the node test inline into the loop.
     #[target_feature(enable = "avx2")]
     pub(in crate::wide::quantized) fn walk_ray_avx2<
+        P: Plane,
         const ANY_HIT: bool,
         C: raybench_accel::CounterSink,
     >(
-        bvh: &BvhQuantized,
+        bvh: &BvhQuantized<P>,
         k: Avx2Nodes,
         ray: &Ray,
         stack: &mut Stack,
@@ -120,8 +133,8 @@ mod avx2 {
     macro_rules! batch_loops {
         ($features:literal, $closest:ident, $any:ident) => {
             #[target_feature(enable = $features)]
-            fn $closest(
-                bvh: &BvhQuantized,
+            fn $closest<P: Plane>(
+                bvh: &BvhQuantized<P>,
                 k: Avx2Nodes,
                 rays: &[Ray],
                 out: &mut [Option<Hit>],
@@ -133,8 +146,8 @@ mod avx2 {
             }
 
             #[target_feature(enable = $features)]
-            fn $any(
-                bvh: &BvhQuantized,
+            fn $any<P: Plane>(
+                bvh: &BvhQuantized<P>,
                 k: Avx2Nodes,
                 rays: &[Ray],
                 out: &mut [bool],
@@ -156,8 +169,8 @@ mod avx2 {
         occluded_all_avx512
     );
 
-    pub(in crate::wide::quantized) fn intersect_all(
-        bvh: &BvhQuantized,
+    pub(in crate::wide::quantized) fn intersect_all<P: Plane>(
+        bvh: &BvhQuantized<P>,
         k: Avx2Nodes,
         rays: &[Ray],
         out: &mut [Option<Hit>],
@@ -172,8 +185,8 @@ mod avx2 {
         }
     }
 
-    pub(in crate::wide::quantized) fn occluded_all(
-        bvh: &BvhQuantized,
+    pub(in crate::wide::quantized) fn occluded_all<P: Plane>(
+        bvh: &BvhQuantized<P>,
         k: Avx2Nodes,
         rays: &[Ray],
         out: &mut [bool],
@@ -197,6 +210,11 @@ mod avx2 {
         /// rays in every direction octant, axis-parallel ones included.
         #[test]
         fn avx2_test_matches_the_portable_test() {
+            matches_portable::<u8>();
+            matches_portable::<u16>();
+        }
+
+        fn matches_portable<P: Plane>() {
             use crate::wide::kernels::{NodeKernel, SseNodes};
             use raybench_geom::Vec3;
             let Some(k) = Avx2Nodes::detect(false) else {
@@ -210,7 +228,7 @@ mod avx2 {
                 (rng >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
             };
             let mut checked = 0;
-            for n in super::super::super::node::tests::sample_nodes() {
+            for n in super::super::super::node::tests::sample_nodes::<P>() {
                 for i in 0..2000 {
                     // Aimed at a point of one child from around it, or along an axis (±0 in
                     // the other components) every sixth ray.
@@ -232,10 +250,10 @@ mod avx2 {
                     }
                     let ray = Ray::infinite(o, dir);
                     let (sse, avx) = (SseNodes, k);
-                    let (ms, es) =
-                        sse.test_quantized(&NodeKernel::<QWIDTH>::ray(sse, &ray), &n, 0.0, 1e30);
-                    let (ma, ea) =
-                        avx.test_quantized(&NodeKernel::<QWIDTH>::ray(avx, &ray), &n, 0.0, 1e30);
+                    let sr = NodeKernel::<QWIDTH>::ray(sse, &ray);
+                    let ar = NodeKernel::<QWIDTH>::ray(avx, &ray);
+                    let (ms, es) = QuantKernel::<P>::test_quantized(sse, &sr, &n, 0.0, 1e30);
+                    let (ma, ea) = QuantKernel::<P>::test_quantized(avx, &ar, &n, 0.0, 1e30);
                     assert_eq!(ms, ma, "{ray:?}");
                     for lane in 0..QWIDTH {
                         if ms & (1 << lane) != 0 {

@@ -28,19 +28,19 @@ mod walk;
 
 use super::{Bvh8, NodeFormat, WideParams};
 use crate::node::ChildRef;
-use node::QNode;
+use node::{Plane, QNode};
 use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Hit, Memory, NoCount, PreparedRays, Walk,
 };
 use raybench_geom::{Aabb, Ray, Tri4, TriangleMesh, Vec3};
 use std::sync::Arc;
 
-/// An 8-wide BVH of quantized nodes ([`QNode`]); leaves as [`Bvh8`]'s, a leaf reference is
-/// `{ index: first Tri4, count: triangles }`.
+/// An 8-wide BVH of quantized nodes ([`QNode`]) with planes of type `P`; leaves as
+/// [`Bvh8`]'s, a leaf reference is `{ index: first Tri4, count: triangles }`.
 #[derive(Debug)]
-pub struct BvhQuantized {
+pub struct BvhQuantized<P: Plane> {
     params: WideParams,
-    nodes: Vec<QNode>,
+    nodes: Vec<QNode<P>>,
     root: ChildRef,
     root_bounds: Aabb,
     tri4s: Vec<Tri4>,
@@ -51,8 +51,13 @@ pub struct BvhQuantized {
     avx2: Option<super::avx2::Avx2Nodes>,
 }
 
-impl BvhQuantized {
-    pub fn nodes(&self) -> &[QNode] {
+/// 8-bit planes, 128-byte nodes: the registry's `bvh8-compressed`.
+pub type Bvh8Compressed = BvhQuantized<u8>;
+/// 16-bit planes, 192-byte nodes: the registry's `bvh8-compressed16`.
+pub type Bvh8Compressed16 = BvhQuantized<u16>;
+
+impl<P: Plane> BvhQuantized<P> {
+    pub fn nodes(&self) -> &[QNode<P>] {
         &self.nodes
     }
 
@@ -74,7 +79,7 @@ impl BvhQuantized {
 
     /// Mean over all children of the decoded box's surface area over the float box's: what
     /// the rounding costs in entered boxes (1 would be lossless).
-    fn area_growth(float: &Bvh8, nodes: &[QNode]) -> f64 {
+    fn area_growth(float: &Bvh8, nodes: &[QNode<P>]) -> f64 {
         let (mut sum, mut n) = (0.0, 0usize);
         for (f, q) in float.nodes().iter().zip(nodes) {
             for i in 0..q.children() {
@@ -89,14 +94,16 @@ impl BvhQuantized {
     }
 }
 
-impl Accel for BvhQuantized {
+impl<P: Plane> Accel for BvhQuantized<P> {
     type Params = WideParams;
 
-    fn build(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<BvhQuantized, BuildError> {
-        if params.node_format != NodeFormat::Quantized {
-            return Err(BuildError::Unsupported(
-                "a quantized BVH built with node_format = float".into(),
-            ));
+    fn build(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<BvhQuantized<P>, BuildError> {
+        if params.node_format != P::FORMAT {
+            return Err(BuildError::Unsupported(format!(
+                "a {:?} BVH built with node_format = {:?}",
+                P::FORMAT,
+                params.node_format
+            )));
         }
         if params.coherent_packets {
             return Err(BuildError::Unsupported(
@@ -110,12 +117,14 @@ impl Accel for BvhQuantized {
                 ..params.clone()
             },
         )?;
-        let nodes: Vec<QNode> = {
+        let nodes: Vec<QNode<P>> = {
             use rayon::prelude::*;
             float.nodes().par_iter().map(QNode::quantize).collect()
         };
         let mut stats = float.build_stats();
-        stats.extra.insert("node_bytes".into(), 128.0);
+        stats
+            .extra
+            .insert("node_bytes".into(), std::mem::size_of::<QNode<P>>() as f64);
         stats
             .extra
             .insert("area_growth".into(), Self::area_growth(&float, &nodes));
@@ -142,7 +151,10 @@ impl Accel for BvhQuantized {
     }
 
     fn name(&self) -> &str {
-        "bvh8-compressed"
+        match P::FORMAT {
+            NodeFormat::Quantized16 => "bvh8-compressed16",
+            _ => "bvh8-compressed",
+        }
     }
 
     raybench_accel::walk_queries!();
@@ -192,7 +204,7 @@ impl Accel for BvhQuantized {
     }
 }
 
-impl Walk for BvhQuantized {
+impl<P: Plane> Walk for BvhQuantized<P> {
     fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
         self.trace_single::<ANY_HIT, C>(ray, c)
     }

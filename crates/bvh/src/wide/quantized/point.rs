@@ -5,13 +5,13 @@
 //! brute force's.
 
 use super::BvhQuantized;
-use super::node::QWIDTH;
+use super::node::{Plane, QWIDTH};
 use crate::node::ChildRef;
 use crate::wide::STACK;
 use raybench_accel::{CounterSink, Nearest, PointHit};
 use raybench_geom::{Vec3, box_distance_squared};
 
-impl BvhQuantized {
+impl<P: Plane> BvhQuantized<P> {
     pub(super) fn closest_point_walk<C: CounterSink>(
         &self,
         p: Vec3,

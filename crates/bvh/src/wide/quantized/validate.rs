@@ -3,12 +3,12 @@
 //! check is the one a walk relies on: every decoded child box holds every triangle below it.
 
 use super::BvhQuantized;
-use super::node::{QNode, QWIDTH, step};
+use super::node::{Plane, QNode, QWIDTH, step};
 use crate::node::{ChildRef, MAX_DEPTH};
 use crate::wide::validate::check_lanes;
 use raybench_geom::{Aabb, NO_PRIM, TriangleMesh};
 
-impl BvhQuantized {
+impl<P: Plane> BvhQuantized<P> {
     /// Every decoded child box holds the bounds of the triangles below it; every node's
     /// frame sound (finite origins that flush-to-zero leaves alone, steps a normal power of
     /// two, `min <= max` bytes in used slots, zero bytes in unused ones, 2 to 8 children);
@@ -105,7 +105,7 @@ impl BvhQuantized {
 }
 
 /// A node's grid and bytes, independent of what lies below it.
-fn check_frame(n: &QNode) -> Result<(), String> {
+fn check_frame<P: Plane>(n: &QNode<P>) -> Result<(), String> {
     let used = n.children();
     if !(2..=QWIDTH).contains(&used) {
         return Err(format!("{used} children"));
@@ -120,17 +120,17 @@ fn check_frame(n: &QNode) -> Result<(), String> {
             return Err(format!("exponent {} on axis {axis}", n.exp[axis]));
         }
         for i in 0..QWIDTH {
-            let (lo, hi) = (n.q[axis][0][i], n.q[axis][1][i]);
+            let (lo, hi) = (n.q[axis][0][i].get(), n.q[axis][1][i].get());
             if i >= used && (lo, hi) != (0, 0) {
-                return Err(format!("bytes in unused slot {i}"));
+                return Err(format!("planes in unused slot {i}"));
             }
             if lo > hi {
-                return Err(format!("slot {i} has min byte {lo} above max byte {hi}"));
+                return Err(format!("slot {i} has min plane {lo} above max {hi}"));
             }
         }
         for side in 0..2 {
             for i in 0..used {
-                let plane = super::node::decode(o, s, n.q[axis][side][i]);
+                let plane = super::node::decode(o, s, n.q[axis][side][i].get());
                 if !(plane == 0.0 || plane.is_normal()) {
                     return Err(format!("slot {i} decodes to {plane}, not zero or normal"));
                 }
@@ -143,6 +143,7 @@ fn check_frame(n: &QNode) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::super::BvhQuantized;
+    use super::super::node::Plane;
     use crate::wide::{NodeFormat, WideParams};
     use raybench_accel::Accel;
 
@@ -150,22 +151,27 @@ mod tests {
     /// bytes.
     #[test]
     fn the_validator_rejects_a_shrunken_box() {
+        rejects::<u8>(NodeFormat::Quantized);
+        rejects::<u16>(NodeFormat::Quantized16);
+    }
+
+    fn rejects<P: Plane>(node_format: NodeFormat) {
         let mesh = raybench_testkit::generated("teapot:triangles=2000", 1);
         let params = WideParams {
-            node_format: NodeFormat::Quantized,
+            node_format,
             ..WideParams::for_width(8)
         };
-        let mut q = BvhQuantized::build(mesh.clone(), &params).expect("builds");
+        let mut q = BvhQuantized::<P>::build(mesh.clone(), &params).expect("builds");
         q.validate(&mesh).expect("valid as built");
         let slot = (0..q.nodes[0].children())
-            .find(|&i| q.nodes[0].q[0][1][i] > q.nodes[0].q[0][0][i])
+            .find(|&i| q.nodes[0].q[0][1][i].get() > q.nodes[0].q[0][0][i].get())
             .expect("a child with some extent in x");
-        q.nodes[0].q[0][1][slot] -= 1;
+        q.nodes[0].q[0][1][slot] = P::new(q.nodes[0].q[0][1][slot].get() - 1);
         let e = q.validate(&mesh).expect_err("a shrunken box");
         assert!(e.contains("does not hold"), "{e}");
-        q.nodes[0].q[0][1][slot] = 0;
-        q.nodes[0].q[0][0][slot] = 255;
+        q.nodes[0].q[0][1][slot] = P::new(0);
+        q.nodes[0].q[0][0][slot] = P::new(P::TOP);
         let e = q.validate(&mesh).expect_err("inverted bytes");
-        assert!(e.contains("above max byte"), "{e}");
+        assert!(e.contains("above max"), "{e}");
     }
 }

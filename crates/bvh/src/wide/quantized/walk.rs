@@ -3,7 +3,7 @@
 
 use super::BvhQuantized;
 use super::kernels::QuantKernel;
-use super::node::QNode;
+use super::node::{Plane, QNode};
 use crate::simd::prefetch;
 use crate::wide::kernels::SseNodes;
 use crate::wide::walk::{Stack, first_in_slot_order, nearest_first, new_stack};
@@ -16,13 +16,13 @@ thread_local! {
     static STACK_TLS: RefCell<Box<Stack>> = RefCell::new(new_stack());
 }
 
-impl BvhQuantized {
+impl<P: Plane> BvhQuantized<P> {
     /// The one traversal loop — closest or any hit, counted or not — for a given kernel, with
     /// the float walk's child ordering, so its answers are the float tree's: a quantized box
     /// only ever holds its float box, so the walk may enter more children, and it still
     /// visits every subtree the float walk visits before its closest hit is final.
     #[inline(always)]
-    pub(super) fn walk_with<const ANY_HIT: bool, C: CounterSink, K: QuantKernel>(
+    pub(super) fn walk_with<const ANY_HIT: bool, C: CounterSink, K: QuantKernel<P>>(
         &self,
         kernel: K,
         ray: &Ray,
@@ -77,10 +77,10 @@ impl BvhQuantized {
         best.map(|(lane, h)| Hit::from_tri_hit(self.tri4s[lane / 4].ids[lane % 4], h))
     }
 
-    /// Starts fetching every child in `mask`: a node's two lines (boxes, then child
-    /// references), or a leaf's first `Tri4` (three lines).
+    /// Starts fetching every child in `mask`: all of a node's lines (two or three), or a
+    /// leaf's first `Tri4` (three lines).
     #[inline(always)]
-    fn prefetch_children(&self, n: &QNode, mut mask: u32) {
+    fn prefetch_children(&self, n: &QNode<P>, mut mask: u32) {
         while mask != 0 {
             let r = n.child[mask.trailing_zeros() as usize];
             mask &= mask - 1;
@@ -103,7 +103,9 @@ impl BvhQuantized {
         #[cfg(target_arch = "x86_64")]
         if let Some(k) = self.avx2 {
             // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
-            return unsafe { super::kernels::walk_ray_avx2::<ANY_HIT, C>(self, k, ray, stack, c) };
+            return unsafe {
+                super::kernels::walk_ray_avx2::<P, ANY_HIT, C>(self, k, ray, stack, c)
+            };
         }
         self.walk_with::<ANY_HIT, C, SseNodes>(SseNodes, ray, stack, c)
     }
