@@ -142,48 +142,48 @@ pub fn axis_frame(lo: f32, hi: f32, top: u32) -> (f32, i8) {
     (origin, e as i8)
 }
 
+/// The smallest `q` in `lo..=hi` for which `pred` holds, `hi + 1` if none; `pred` must be
+/// false then true along `q` (decoding is monotonic in `q`), so a binary search finds it in
+/// 16 steps at most even where thousands of 16-bit values decode alike.
+fn first(mut lo: u32, mut hi: u32, pred: impl Fn(u32) -> bool) -> u32 {
+    hi += 1;
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if pred(mid) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    lo
+}
+
 /// A plane value whose plane is the highest at or below `x` and unchanged by flush-to-zero (0
 /// always qualifies: it decodes to the origin, at or below every child). Where a step is
 /// smaller than the rounding of the addition, several values decode alike; of those, the
 /// lowest, so that a flat child never gets its min above its max.
 pub fn round_down(origin: f32, e: i8, x: f32, top: u32) -> u32 {
     let s = step(e);
-    let guess = ((x as f64 - origin as f64) / s as f64)
-        .floor()
-        .clamp(0.0, top as f64) as u32;
-    let ok = |q: u32| decode(origin, s, q) <= x && ftz_safe(decode(origin, s, q));
-    let mut q = guess;
-    while q > 0 && !ok(q) {
+    let at = |q: u32| decode(origin, s, q);
+    let mut q = first(0, top, |q| at(q) > x).saturating_sub(1);
+    // Subnormal planes span less than two steps (a step is at least the smallest normal).
+    while q > 0 && !ftz_safe(at(q)) {
         q -= 1;
     }
-    while q < top && ok(q + 1) {
-        q += 1;
-    }
-    while q > 0 && decode(origin, s, q - 1) == decode(origin, s, q) {
-        q -= 1;
-    }
-    q
+    first(0, q, |k| at(k) >= at(q))
 }
 
-/// A plane value whose plane is the lowest at or above `x` and unchanged by flush-to-zero (`top`
-/// qualifies by the choice of the exponent); of several values decoding alike, the highest.
+/// A plane value whose plane is the lowest at or above `x` and unchanged by flush-to-zero
+/// (`top` qualifies by the choice of the exponent); of several values decoding alike, the
+/// highest.
 pub fn round_up(origin: f32, e: i8, x: f32, top: u32) -> u32 {
     let s = step(e);
-    let guess = ((x as f64 - origin as f64) / s as f64)
-        .ceil()
-        .clamp(0.0, top as f64) as u32;
-    let ok = |q: u32| decode(origin, s, q) >= x && ftz_safe(decode(origin, s, q));
-    let mut q = guess;
-    while q < top && !ok(q) {
+    let at = |q: u32| decode(origin, s, q);
+    let mut q = first(0, top, |q| at(q) >= x);
+    while q < top && !ftz_safe(at(q)) {
         q += 1;
     }
-    while q > 0 && ok(q - 1) {
-        q -= 1;
-    }
-    while q < top && decode(origin, s, q + 1) == decode(origin, s, q) {
-        q += 1;
-    }
-    q
+    first(q, top, |k| at(k) > at(q)) - 1
 }
 
 impl<P: Plane> QNode<P> {
