@@ -1,24 +1,27 @@
-//! The compressed 8-wide BVH (`bvh8-compressed`): the `bvh8-binned` tree with every node's
-//! child boxes quantized to bytes, 128 bytes a node instead of 256.
+//! The compressed 8-wide BVHs (`bvh8-compressed`, `bvh8-compressed16`): the `bvh8-binned`
+//! tree with every node's child boxes quantized to 8-bit planes (128 bytes a node instead of
+//! 256) or 16-bit ones (192 bytes).
 //!
 //! Algorithm: as the compressed wide BVHs of Ylitie, Karras and Laine ("Efficient incoherent
 //! ray traversal on GPUs through compressed wide BVHs", HPG 2017) and Embree's quantized
 //! BVH8 nodes, each node stores per axis an origin and a power-of-two step covering the union
-//! of its children, and each child plane as a byte counted in steps from the origin, minima
-//! rounded down and maxima up, so a decoded box always holds the float box (`node.rs`). The
-//! tree, leaves and child order are the float tree's (built by [`Bvh8`] and converted); only
-//! the node format differs, so the report isolates what compression buys. The box test
-//! decodes a node's planes (one widening conversion, a multiply and an add per plane with
-//! AVX2) and runs the float kernel's slab test on them (`kernels.rs`, `walk.rs`).
+//! of its children, and each child plane as an integer counted in steps from the origin,
+//! minima rounded down and maxima up, so a decoded box always holds the float box
+//! (`node.rs`). The tree, leaves and child order are the float tree's (built by [`Bvh8`] and
+//! converted); only the node format differs, so the report isolates what compression buys.
+//! The box test decodes a node's planes (one widening conversion, a multiply and an add per
+//! plane with AVX2) and runs the float kernel's slab test on them (`kernels.rs`, `walk.rs`).
 //!
-//! Trade-off: a node is two cache lines instead of four — the boxes in the first, the child
-//! references in the second — for six decodes per node test, and a rounded-out box lets some
+//! Trade-off: the box test reads one cache line (8 bits) or two (16 bits) instead of three,
+//! for six decodes per node test on the walk's critical path; and a rounded-out box lets some
 //! rays into children the float box would have kept them out of (more nodes and leaves
-//! visited; the answers are the same). It pays when node fetches miss the caches (large
-//! scenes, incoherent rays) and costs when the tree fits in them. Caveat: the grid of a node
-//! spans its own bounds in 255 steps, so a tiny child in a large node grows by up to one step
-//! per side (a `256`th of the node's extent); the child references are kept whole (8 bytes
-//! each) rather than compressed to offsets, which would need each node's children contiguous.
+//! visited; the closest hit is the same). It can pay only when node fetches miss the caches;
+//! measured on the project machine, where the scenes' trees fit in them, both formats are
+//! slower than `bvh8-binned` (docs/experiments.md, "Compressed wide BVH"). Caveat: with 8-bit
+//! planes a child grows by up to a 255th of its node's extent per side, so a flat leaf box (a
+//! wall) gains a thickness and a ray leaving the wall enters the leaf it starts on; the child
+//! references are kept whole (8 bytes each) rather than compressed to offsets, which would
+//! need each node's children contiguous.
 
 mod kernels;
 pub mod node;
