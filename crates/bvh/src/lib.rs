@@ -24,10 +24,13 @@ mod traverse;
 mod validate;
 pub mod wide;
 
-pub use build::reinsert::{ReinsertStats, Reinsertion};
 pub use build::SpatialSplits;
+pub use build::reinsert::{ReinsertStats, Reinsertion};
 pub use node::{ChildRef, MAX_DEPTH, Node};
-pub use wide::{Bvh4, Bvh8, BvhWide, NodeSimd, WideParams};
+pub use wide::{
+    Bvh4, Bvh8, Bvh8Compressed, Bvh8Compressed16, BvhQuantized, BvhWide, NodeFormat, NodeSimd,
+    WideParams,
+};
 
 use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, Walk};
 use raybench_geom::{MollerTriangle, Ray, TriangleMesh};

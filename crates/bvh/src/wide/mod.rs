@@ -39,12 +39,14 @@ mod pack;
 #[cfg(target_arch = "x86_64")]
 mod packets;
 mod params;
+mod quantized;
 mod stats;
 mod validate;
 mod walk;
 
 pub use node::WideNode;
-pub use params::{NodeSimd, WideParams};
+pub use params::{NodeFormat, NodeSimd, WideParams};
+pub use quantized::{Bvh8Compressed, Bvh8Compressed16, BvhQuantized, node::Plane, node::QNode};
 
 pub(crate) use node::quad;
 pub(crate) use walk::STACK;
@@ -163,6 +165,11 @@ impl<const W: usize> Accel for BvhWide<W> {
                 "width {} in a {W}-wide BVH",
                 params.width
             )));
+        }
+        if params.node_format != NodeFormat::Float {
+            return Err(BuildError::Unsupported(
+                "quantized nodes in a float BVH (see BvhQuantized)".into(),
+            ));
         }
         let built = build::build(&mesh, &params.binary)?;
         let (mut flat, reinsertion) = build::reinsert::optimize(built, &params.binary);

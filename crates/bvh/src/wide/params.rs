@@ -20,6 +20,21 @@ pub enum NodeSimd {
     Sse,
 }
 
+/// How a wide node stores its children's boxes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NodeFormat {
+    /// Six f32 planes per child: 8 wide, 256 bytes a node ([`Bvh8`](super::Bvh8)).
+    #[default]
+    Float,
+    /// One byte per plane on a per-node grid, rounded outward: 8 wide, 128 bytes a node
+    /// ([`Bvh8Compressed`](super::Bvh8Compressed), the registry's `bvh8-compressed`).
+    Quantized,
+    /// Two bytes per plane, the same rounding: 8 wide, 192 bytes a node
+    /// ([`Bvh8Compressed16`](super::Bvh8Compressed16), the registry's `bvh8-compressed16`).
+    Quantized16,
+}
+
 /// Knobs of a wide BVH: the binary tree it is collapsed from, the node width and the node
 /// test.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -40,6 +55,8 @@ pub struct WideParams {
     /// when the CPU has AVX-512F; every other batch, and every batch without AVX-512, ray by
     /// ray. The registry's `bvh8-packets`.
     pub coherent_packets: bool,
+    /// The node format; each tree type is built only with its own.
+    pub node_format: NodeFormat,
 }
 
 impl WideParams {
@@ -83,6 +100,7 @@ impl Default for WideParams {
             node_simd: NodeSimd::Auto,
             fill_slots: true,
             coherent_packets: false,
+            node_format: NodeFormat::Float,
         }
     }
 }

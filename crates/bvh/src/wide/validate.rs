@@ -5,12 +5,6 @@ use crate::node::{ChildRef, MAX_DEPTH};
 use raybench_geom::{Aabb, MollerTriangle, NO_PRIM, Tri4, TriangleMesh};
 
 impl<const W: usize> BvhWide<W> {
-    /// The mesh index of every `Tri4` lane in order (`4 * tri4 + lane`), [`NO_PRIM`] for
-    /// unused lanes.
-    fn lane_ids(&self) -> impl Iterator<Item = u32> + '_ {
-        self.tri4s.iter().flat_map(|t| t.ids)
-    }
-
     /// Every child box inside its parent's; leaves tiling the `Tri4`s in depth-first order,
     /// their triangles in the first lanes and the rest empty; every lane equal to its mesh
     /// triangle; every mesh triangle exactly once; depth within the stack bound. With spatial
@@ -19,7 +13,11 @@ impl<const W: usize> BvhWide<W> {
     /// ([`check_references`](crate::cover::check_references)).
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         let n = mesh.len();
-        self.check_lanes(mesh)?;
+        check_lanes(
+            &self.tri4s,
+            mesh,
+            self.params.binary.spatial_splits.is_some(),
+        )?;
         if n == 0 {
             return Ok(());
         }
@@ -44,34 +42,6 @@ impl<const W: usize> BvhWide<W> {
             ));
         }
         Ok(())
-    }
-
-    /// Every used lane is its mesh triangle, every mesh triangle is in exactly one lane, and
-    /// unused lanes are the all-zero triangle.
-    fn check_lanes(&self, mesh: &TriangleMesh) -> Result<(), String> {
-        let mut seen = vec![false; mesh.len()];
-        for (slot, id) in self.lane_ids().enumerate() {
-            let lane = self.tri4s[slot / 4].lane(slot % 4);
-            if id == NO_PRIM {
-                if lane != Tri4::default().lane(0) {
-                    return Err(format!("unused lane {slot} holds a triangle"));
-                }
-                continue;
-            }
-            let s = seen
-                .get_mut(id as usize)
-                .ok_or(format!("prim id {id} out of range"))?;
-            if std::mem::replace(s, true) && self.params.binary.spatial_splits.is_none() {
-                return Err(format!("prim id {id} appears twice"));
-            }
-            if lane != MollerTriangle::new(&mesh.triangle(id as usize)) {
-                return Err(format!("lane {slot} is not mesh triangle {id}"));
-            }
-        }
-        match seen.iter().position(|&s| !s) {
-            Some(missing) => Err(format!("mesh triangle {missing} is in no leaf")),
-            None => Ok(()),
-        }
     }
 
     fn check_subtree(
@@ -162,6 +132,38 @@ impl<const W: usize> BvhWide<W> {
         }
         *covered += tri4s;
         Ok(())
+    }
+}
+
+/// Every used lane is its mesh triangle, every mesh triangle is in exactly one lane (in one or
+/// more with `spatial_splits`), and unused lanes are the all-zero triangle.
+pub(super) fn check_lanes(
+    tri4s: &[Tri4],
+    mesh: &TriangleMesh,
+    spatial_splits: bool,
+) -> Result<(), String> {
+    let mut seen = vec![false; mesh.len()];
+    for (slot, id) in tri4s.iter().flat_map(|t| t.ids).enumerate() {
+        let lane = tri4s[slot / 4].lane(slot % 4);
+        if id == NO_PRIM {
+            if lane != Tri4::default().lane(0) {
+                return Err(format!("unused lane {slot} holds a triangle"));
+            }
+            continue;
+        }
+        let s = seen
+            .get_mut(id as usize)
+            .ok_or(format!("prim id {id} out of range"))?;
+        if std::mem::replace(s, true) && !spatial_splits {
+            return Err(format!("prim id {id} appears twice"));
+        }
+        if lane != MollerTriangle::new(&mesh.triangle(id as usize)) {
+            return Err(format!("lane {slot} is not mesh triangle {id}"));
+        }
+    }
+    match seen.iter().position(|&s| !s) {
+        Some(missing) => Err(format!("mesh triangle {missing} is in no leaf")),
+        None => Ok(()),
     }
 }
 

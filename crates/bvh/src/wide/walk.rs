@@ -32,8 +32,8 @@ thread_local! {
 /// not kept: an any-hit walk ends at its first hit, so `t_max` never shrinks and no pushed
 /// subtree is ever skipped (the pop does not look at them either).
 #[inline(always)]
-fn first_in_slot_order<const W: usize>(
-    n: &WideNode<W>,
+pub(super) fn first_in_slot_order<const W: usize>(
+    child: &[ChildRef; W],
     mask: u32,
     stack: &mut Stack,
     sp: &mut usize,
@@ -43,18 +43,18 @@ fn first_in_slot_order<const W: usize>(
     while rest != 0 {
         let i = 31 - rest.leading_zeros() as usize;
         rest &= !(1 << i);
-        stack[*sp] = (n.child[i], 0.0);
+        stack[*sp] = (child[i], 0.0);
         *sp += 1;
     }
-    n.child[first]
+    child[first]
 }
 
-/// Of the children of `n` in `mask` (entry distances `entry`), returns the nearest and pushes
+/// Of the children `child` in `mask` (entry distances `entry`), returns the nearest and pushes
 /// the others so that they pop nearest first (equal distances: lower slot first). One and two
 /// children — most nodes — take a short path; more are inserted into the stack in place.
 #[inline(always)]
-fn nearest_first<const W: usize>(
-    n: &WideNode<W>,
+pub(super) fn nearest_first<const W: usize>(
+    child: &[ChildRef; W],
     mut mask: u32,
     entry: &[f32; W],
     stack: &mut Stack,
@@ -63,21 +63,21 @@ fn nearest_first<const W: usize>(
     let a = mask.trailing_zeros() as usize;
     mask &= mask - 1;
     if mask == 0 {
-        return n.child[a];
+        return child[a];
     }
     let b = mask.trailing_zeros() as usize;
     mask &= mask - 1;
     if mask == 0 {
         let (near, far) = if entry[b] < entry[a] { (b, a) } else { (a, b) };
-        stack[*sp] = (n.child[far], entry[far]);
+        stack[*sp] = (child[far], entry[far]);
         *sp += 1;
-        return n.child[near];
+        return child[near];
     }
     // Three or more: keep stack[base..] in decreasing distance, the nearest on top; a later
     // (higher) slot goes below earlier slots at the same distance.
     let base = *sp;
     let mut insert = |i: usize| {
-        let e = (n.child[i], entry[i]);
+        let e = (child[i], entry[i]);
         let mut j = *sp;
         while j > base && stack[j - 1].1 <= e.1 {
             stack[j] = stack[j - 1];
@@ -133,9 +133,9 @@ impl<const W: usize> BvhWide<W> {
                 if mask != 0 {
                     self.prefetch_children(n, mask);
                     r = if ANY_HIT {
-                        first_in_slot_order(n, mask, stack, &mut sp)
+                        first_in_slot_order(&n.child, mask, stack, &mut sp)
                     } else {
-                        nearest_first(n, mask, &entry, stack, &mut sp)
+                        nearest_first(&n.child, mask, &entry, stack, &mut sp)
                     };
                     continue 'walk;
                 }

@@ -52,9 +52,9 @@ impl Avx2Nodes {
 /// The ray for the AVX2 tests: origin, direction, inverse direction and `t_min` splatted to 8
 /// lanes, and per axis which stored side (min or max) holds the near planes.
 pub(crate) struct Avx2Ray {
-    origin: [__m256; 3],
-    inv: [__m256; 3],
-    near: [bool; 3],
+    pub(in crate::wide) origin: [__m256; 3],
+    pub(in crate::wide) inv: [__m256; 3],
+    pub(in crate::wide) near: [bool; 3],
     dir: [__m256; 3],
     t_min: __m256,
 }

@@ -1,0 +1,81 @@
+//! Closest-point queries on the quantized tree: the float tree's branch-and-bound walk
+//! (`crate::point`) over the decoded boxes, in scalar code. A decoded box holds its float box,
+//! so its distance is never larger and no subtree that may hold the nearest triangle is
+//! dropped; the leaves compute exact distances from the mesh's vertices, so the answer is
+//! brute force's.
+
+use super::BvhQuantized;
+use super::node::{Plane, QWIDTH};
+use crate::node::ChildRef;
+use crate::wide::STACK;
+use raybench_accel::{CounterSink, Nearest, PointHit};
+use raybench_geom::{Vec3, box_distance_squared};
+
+impl<P: Plane> BvhQuantized<P> {
+    pub(super) fn closest_point_walk<C: CounterSink>(
+        &self,
+        p: Vec3,
+        max_radius: f32,
+        c: &mut C,
+    ) -> Option<PointHit> {
+        let mut nearest = Nearest::within(p, max_radius)?;
+        if self.tri4s.is_empty() || box_distance_squared(p, &self.root_bounds) > nearest.bound_d2()
+        {
+            return None;
+        }
+        let mut stack = [(ChildRef::default(), 0f32); STACK];
+        let mut sp = 0;
+        let mut next = Some(self.root);
+        loop {
+            while let Some(r) = next.take() {
+                if r.is_leaf() {
+                    c.leaf();
+                    let first = 4 * r.index as usize;
+                    for slot in first..first + r.count as usize {
+                        c.prim_tests(1);
+                        let prim = self.tri4s[slot / 4].ids[slot % 4];
+                        nearest.test_triangle(p, prim, &self.mesh.triangle(prim as usize));
+                    }
+                    break;
+                }
+                c.node();
+                let n = &self.nodes[r.index as usize];
+                // The children within the bound, nearest first (insertion sort of at most 8).
+                let mut kids = [(ChildRef::default(), 0f32); QWIDTH];
+                let mut len = 0;
+                for i in 0..n.children() {
+                    let d = box_distance_squared(p, &n.child_bounds(i));
+                    if d > nearest.bound_d2() {
+                        continue;
+                    }
+                    let mut at = len;
+                    while at > 0 && kids[at - 1].1 > d {
+                        kids[at] = kids[at - 1];
+                        at -= 1;
+                    }
+                    kids[at] = (n.child[i], d);
+                    len += 1;
+                }
+                if len == 0 {
+                    break;
+                }
+                // Farthest pushed first, so the nearest pushed one is popped first.
+                for &entry in kids[1..len].iter().rev() {
+                    stack[sp] = entry;
+                    sp += 1;
+                }
+                next = Some(kids[0].0);
+            }
+            // The nearest pushed subtree that may still hold a nearer triangle.
+            while sp > 0 && next.is_none() {
+                sp -= 1;
+                if stack[sp].1 <= nearest.bound_d2() {
+                    next = Some(stack[sp].0);
+                }
+            }
+            if next.is_none() {
+                return nearest.into_hit();
+            }
+        }
+    }
+}

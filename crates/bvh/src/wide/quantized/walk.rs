@@ -1,0 +1,120 @@
+//! The quantized tree's traversal loop: the float tree's ordered walk with each node decoded
+//! before its test.
+
+use super::BvhQuantized;
+use super::kernels::QuantKernel;
+use super::node::{Plane, QNode};
+use crate::simd::prefetch;
+use crate::wide::kernels::SseNodes;
+use crate::wide::walk::{Stack, first_in_slot_order, nearest_first, new_stack};
+use raybench_accel::{CounterSink, Hit};
+use raybench_geom::{Ray, TriHit};
+use std::cell::RefCell;
+
+thread_local! {
+    /// The single-ray paths' traversal stack, allocated once per thread.
+    static STACK_TLS: RefCell<Box<Stack>> = RefCell::new(new_stack());
+}
+
+impl<P: Plane> BvhQuantized<P> {
+    /// The one traversal loop — closest or any hit, counted or not — for a given kernel, with
+    /// the float walk's child ordering, so its answers are the float tree's: a quantized box
+    /// only ever holds its float box, so the walk may enter more children, and it still
+    /// visits every subtree the float walk visits before its closest hit is final.
+    #[inline(always)]
+    pub(super) fn walk_with<const ANY_HIT: bool, C: CounterSink, K: QuantKernel<P>>(
+        &self,
+        kernel: K,
+        ray: &Ray,
+        stack: &mut Stack,
+        c: &mut C,
+    ) -> Option<Hit> {
+        if self.tri4s.is_empty() {
+            return None;
+        }
+        let t_min = ray.t_min();
+        let mut best_t = ray.t_max();
+        let wide = kernel.ray(ray);
+        let mut best: Option<(usize, TriHit)> = None;
+        let mut sp = 0;
+        let mut r = self.root;
+        'walk: loop {
+            if r.is_leaf() {
+                c.leaf();
+                c.prim_tests(r.count as u64);
+                let first = r.index as usize;
+                let leaf = &self.tri4s[first..first + (r.count as usize).div_ceil(4)];
+                if kernel.leaf::<ANY_HIT>(&wide, leaf, first, &mut best_t, &mut best) {
+                    break 'walk;
+                }
+            } else {
+                c.node();
+                let n = &self.nodes[r.index as usize];
+                let (mask, entry) = kernel.test_quantized(&wide, n, t_min, best_t);
+                if mask != 0 {
+                    self.prefetch_children(n, mask);
+                    r = if ANY_HIT {
+                        first_in_slot_order(&n.child, mask, stack, &mut sp)
+                    } else {
+                        nearest_first(&n.child, mask, &entry, stack, &mut sp)
+                    };
+                    continue 'walk;
+                }
+            }
+            // Pop the nearest pushed subtree that may still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    break 'walk;
+                }
+                sp -= 1;
+                let (next, t_entry) = stack[sp];
+                if ANY_HIT || t_entry <= best_t {
+                    r = next;
+                    continue 'walk;
+                }
+            }
+        }
+        best.map(|(lane, h)| Hit::from_tri_hit(self.tri4s[lane / 4].ids[lane % 4], h))
+    }
+
+    /// Starts fetching every child in `mask`: all of a node's lines (two or three), or a
+    /// leaf's first `Tri4` (three lines).
+    #[inline(always)]
+    fn prefetch_children(&self, n: &QNode<P>, mut mask: u32) {
+        while mask != 0 {
+            let r = n.child[mask.trailing_zeros() as usize];
+            mask &= mask - 1;
+            if r.is_leaf() {
+                prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
+            } else {
+                prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
+            }
+        }
+    }
+
+    /// [`BvhQuantized::walk_with`] with the kernel chosen at build time.
+    #[inline(always)]
+    pub(super) fn trace<const ANY_HIT: bool, C: CounterSink>(
+        &self,
+        ray: &Ray,
+        stack: &mut Stack,
+        c: &mut C,
+    ) -> Option<Hit> {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(k) = self.avx2 {
+            // SAFETY: `k` exists only after `detect` saw AVX2 on this CPU.
+            return unsafe {
+                super::kernels::walk_ray_avx2::<P, ANY_HIT, C>(self, k, ray, stack, c)
+            };
+        }
+        self.walk_with::<ANY_HIT, C, SseNodes>(SseNodes, ray, stack, c)
+    }
+
+    pub(super) fn trace_single<const ANY_HIT: bool, C: CounterSink>(
+        &self,
+        ray: &Ray,
+        c: &mut C,
+    ) -> Option<Hit> {
+        STACK_TLS.with(|s| self.trace::<ANY_HIT, C>(ray, &mut s.borrow_mut(), c))
+    }
+}
