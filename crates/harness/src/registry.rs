@@ -180,6 +180,16 @@ pub fn registry() -> Vec<StructureEntry> {
             |_| WideParams::sbvh(),
         ),
         register::<Bvh8>(
+            "bvh8-sbvh-reinsert",
+            "bvh8-sbvh's Split BVH optimized by bvh8-reinsert's reinsertion before the collapse (both techniques together: what they buy combined)",
+            None,
+            |_| {
+                let mut p = WideParams::sbvh();
+                p.binary.reinsertion = Some(Reinsertion::default());
+                p
+            },
+        ),
+        register::<Bvh8>(
             "bvh8-packets",
             "the bvh8-binned tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane, every other batch ray by ray as bvh8-binned",
             None,

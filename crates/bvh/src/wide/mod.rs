@@ -213,6 +213,12 @@ impl<const W: usize> Accel for BvhWide<W> {
     /// name.
     fn name(&self) -> &str {
         match (W, self.params.coherent_packets) {
+            (8, false)
+                if self.params.binary.spatial_splits.is_some()
+                    && self.params.binary.reinsertion.is_some() =>
+            {
+                "bvh8-sbvh-reinsert"
+            }
             (8, false) if self.params.binary.spatial_splits.is_some() => "bvh8-sbvh",
             (4, _) => "bvh4-binned",
             (_, false) if self.params.binary.reinsertion.is_some() => "bvh8-reinsert",
