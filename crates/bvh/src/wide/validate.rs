@@ -34,14 +34,7 @@ impl<const W: usize> BvhWide<W> {
         if let Some(pieces) = pieces {
             crate::cover::check_references(mesh, pieces)?;
         }
-        if covered != self.tri4s.len() || interior != self.nodes.len() {
-            return Err(format!(
-                "leaves hold {covered} of {} Tri4s; {interior} of {} nodes reachable",
-                self.tri4s.len(),
-                self.nodes.len()
-            ));
-        }
-        Ok(())
+        check_reached(covered, self.tri4s.len(), interior, self.nodes.len())
     }
 
     fn check_subtree(
@@ -133,6 +126,22 @@ impl<const W: usize> BvhWide<W> {
         *covered += tri4s;
         Ok(())
     }
+}
+
+/// The walk from the root reached every `Tri4` (through leaves) and every node, whatever the
+/// node format.
+pub(super) fn check_reached(
+    covered: usize,
+    tri4s: usize,
+    interior: usize,
+    nodes: usize,
+) -> Result<(), String> {
+    if covered != tri4s || interior != nodes {
+        return Err(format!(
+            "leaves hold {covered} of {tri4s} Tri4s; {interior} of {nodes} nodes reachable"
+        ));
+    }
+    Ok(())
 }
 
 /// Every used lane is its mesh triangle, every mesh triangle is in exactly one lane (in one or

@@ -5,7 +5,7 @@
 use super::BvhQuantized;
 use super::node::{Plane, QNode, QWIDTH, step};
 use crate::node::{ChildRef, MAX_DEPTH};
-use crate::wide::validate::check_lanes;
+use crate::wide::validate::{check_lanes, check_reached};
 use raybench_geom::{Aabb, NO_PRIM, TriangleMesh};
 
 impl<P: Plane> BvhQuantized<P> {
@@ -29,14 +29,7 @@ impl<P: Plane> BvhQuantized<P> {
         if !self.root_bounds.contains_box(&bounds) {
             return Err("the root bounds do not hold the triangles".into());
         }
-        if covered != self.tri4s.len() || interior != self.nodes.len() {
-            return Err(format!(
-                "leaves hold {covered} of {} Tri4s; {interior} of {} nodes reachable",
-                self.tri4s.len(),
-                self.nodes.len()
-            ));
-        }
-        Ok(())
+        check_reached(covered, self.tri4s.len(), interior, self.nodes.len())
     }
 
     /// Checks the subtree at `r` and returns the bounds of its triangles.
