@@ -105,6 +105,7 @@ const BRUTE_FORCE_SUITE_LIMIT: usize = 20_000;
 
 /// Every structure raybench knows, in the order reports list them.
 pub fn registry() -> Vec<StructureEntry> {
+    #[cfg_attr(not(feature = "peers"), allow(unused_mut))]
     let mut all = own_structures();
     #[cfg(feature = "peers")]
     all.extend(crate::peers::entries());

@@ -127,3 +127,42 @@ fn a_peer_without_closest_point_is_reported_as_not_offered() {
     let row = table.lines().find(|l| l.contains("peer-bvh")).unwrap();
     assert!(!row.contains("not offered"), "{row}");
 }
+
+/// Builds in a rayon pool of `threads` and traces `rays` (closest hit).
+fn answers_with_threads<A: Accel>(
+    params: &A::Params,
+    mesh: &std::sync::Arc<raybench_geom::TriangleMesh>,
+    rays: &[raybench_geom::Ray],
+    threads: usize,
+) -> Vec<Option<raybench_accel::Hit>>
+where
+    A::Params: Sync,
+{
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let accel = pool.install(|| A::build(mesh.clone(), params).unwrap());
+    rays.iter().map(|r| accel.intersect(r)).collect()
+}
+
+#[test]
+fn peers_answer_identically_whatever_the_build_thread_count() {
+    let mesh = raybench_testkit::generated("soup:triangles=3000", 7);
+    let rays = raybench_testkit::random_rays_in(&mesh.bounds(), 3000, 7);
+    fn same<A: Accel>(
+        p: &A::Params,
+        mesh: &std::sync::Arc<raybench_geom::TriangleMesh>,
+        rays: &[raybench_geom::Ray],
+    ) where
+        A::Params: Sync,
+    {
+        let one = answers_with_threads::<A>(p, mesh, rays, 1);
+        assert!(one.iter().filter(|h| h.is_some()).count() > 100);
+        assert_eq!(one, answers_with_threads::<A>(p, mesh, rays, 2));
+    }
+    same::<BvhCrate>(&BvhCrateParams {}, &mesh, &rays);
+    same::<Obvhs>(&ObvhsParams::default(), &mesh, &rays);
+    same::<Parry>(&ParryParams {}, &mesh, &rays);
+    same::<KdtreeRay>(&KdtreeRayParams {}, &mesh, &rays);
+}
