@@ -184,6 +184,12 @@ pub trait Accel: Send + Sync {
         true
     }
 
+    /// False for structures that cannot answer closest-point queries (some peer crates): runs
+    /// then report the closest-point workloads as "not offered" instead of timing them.
+    fn offers_closest_point(&self) -> bool {
+        true
+    }
+
     /// Converts rays into this structure's layout and checks them; called outside timing.
     fn prepare_rays(&self, _rays: &[Ray]) -> Result<PreparedRays, raybench_geom::RayError> {
         Ok(PreparedRays::Native)

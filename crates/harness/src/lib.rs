@@ -13,6 +13,8 @@ pub mod env;
 pub mod interrupt;
 pub mod outdir;
 pub mod output;
+#[cfg(feature = "peers")]
+pub mod peers;
 pub mod pipeline;
 pub mod registry;
 pub mod report;

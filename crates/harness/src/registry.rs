@@ -44,6 +44,9 @@ pub struct StructureEntry {
     /// Suites skip the structure above this many triangles (it would take too long); naming the
     /// structure explicitly with `--structures` always runs it.
     pub suite_triangle_limit: Option<usize>,
+    /// Another crate's structure wrapped for comparison (`peer-*`), not one of raybench's own:
+    /// `raybench list` shows these under their own heading.
+    pub peer: bool,
     builder: Box<Builder>,
 }
 
@@ -67,7 +70,7 @@ impl StructureEntry {
     }
 }
 
-fn register<A: Accel + 'static>(
+pub(crate) fn register<A: Accel + 'static>(
     name: &'static str,
     description: &'static str,
     suite_triangle_limit: Option<usize>,
@@ -85,6 +88,7 @@ fn register<A: Accel + 'static>(
         name,
         description,
         suite_triangle_limit,
+        peer: false,
         builder: Box::new(builder),
     }
 }
@@ -101,6 +105,14 @@ const BRUTE_FORCE_SUITE_LIMIT: usize = 20_000;
 
 /// Every structure raybench knows, in the order reports list them.
 pub fn registry() -> Vec<StructureEntry> {
+    #[cfg_attr(not(feature = "peers"), allow(unused_mut))]
+    let mut all = own_structures();
+    #[cfg(feature = "peers")]
+    all.extend(crate::peers::entries());
+    all
+}
+
+fn own_structures() -> Vec<StructureEntry> {
     vec![
         register::<BruteForce>(
             "bruteforce",

@@ -8,13 +8,22 @@ use std::io::Write;
 use std::process::ExitCode;
 
 pub fn run() -> Result<ExitCode> {
-    println!("Structures:");
-    for e in registry::registry() {
-        let limit = e
-            .suite_triangle_limit
-            .map(|l| format!(" (suites: up to {l} triangles)"))
-            .unwrap_or_default();
-        println!("  {:<24} {}{limit}", e.name, e.description);
+    let (peers, own): (Vec<_>, Vec<_>) = registry::registry().into_iter().partition(|e| e.peer);
+    for (heading, entries) in [
+        ("Structures:", own),
+        ("\nPeers (other crates' structures):", peers),
+    ] {
+        if entries.is_empty() {
+            continue;
+        }
+        println!("{heading}");
+        for e in entries {
+            let limit = e
+                .suite_triangle_limit
+                .map(|l| format!(" (suites: up to {l} triangles)"))
+                .unwrap_or_default();
+            println!("  {:<24} {}{limit}", e.name, e.description);
+        }
     }
     let mut out = std::io::stdout().lock();
     writeln!(out)?;

@@ -62,6 +62,9 @@ pub fn summary_table(report: &Report) -> String {
                         ratio(x.speedup_vs_reference)
                     );
                 }
+                None if r.not_offered.contains(w) => {
+                    let _ = write!(out, " {:>10} {:>7}", "not offered", "-");
+                }
                 None => {
                     let _ = write!(out, " {:>10} {:>7}", "-", "-");
                 }

@@ -283,8 +283,13 @@ impl SceneRun<'_> {
                 agreement,
             });
         }
+        let mut not_offered = Vec::new();
         for pw in self.point_workloads.iter().filter(|w| !w.points.is_empty()) {
-            workloads.push(self.measure_points(accel, pw, opts));
+            if accel.offers_closest_point() {
+                workloads.push(self.measure_points(accel, pw, opts));
+            } else {
+                not_offered.push(pw.workload.name().to_string());
+            }
         }
         let memory = accel.memory();
         let entry = ResultEntry {
@@ -298,6 +303,7 @@ impl SceneRun<'_> {
             memory,
             build_stats: accel.build_stats(),
             workloads,
+            not_offered,
             primary_image,
         };
         Ok((entry, built))

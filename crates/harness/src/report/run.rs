@@ -110,6 +110,10 @@ pub struct ResultEntry {
     pub memory: Memory,
     pub build_stats: BuildStats,
     pub workloads: Vec<WorkloadResult>,
+    /// Workloads the structure cannot answer (a peer crate without closest-point queries): run
+    /// for no one, reported as "not offered", never as a number. Absent when empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_offered: Vec<String>,
     /// Per-pixel pictures of the primary workload (absent when it was not run).
     #[serde(default)]
     pub primary_image: Option<crate::pipeline::images::PrimaryImage>,
