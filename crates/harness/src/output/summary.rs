@@ -83,6 +83,7 @@ pub fn summary_table(report: &Report) -> String {
         let _ = writeln!(out, " {ambiguous:>9} {mismatch:>9}");
     }
     write_point_work(&mut out, report);
+    write_intervals(&mut out, report);
     write_agreement(&mut out, report);
     write_claims(&mut out, report);
     for n in &report.notes {
@@ -92,6 +93,79 @@ pub fn summary_table(report: &Report) -> String {
         let _ = writeln!(out, "error: {e}");
     }
     out
+}
+
+/// How precise each structure's ratios to the reference are: the half-width of their
+/// confidence intervals (see `report/interval.rs`) relative to the ratio, median and widest,
+/// for throughput and for build time apart (they have different numbers of rounds).
+fn write_intervals(out: &mut String, report: &Report) {
+    // Per structure: (relative half-width, where) for traces, and for builds.
+    type Widths = Vec<(f64, String)>;
+    let mut rows: Vec<(&str, Widths, Widths)> = Vec::new();
+    let (mut trace_level, mut build_level) = (f64::INFINITY, f64::INFINITY);
+    for r in report
+        .results
+        .iter()
+        .filter(|r| r.structure != report.run.reference)
+    {
+        let at = match rows.iter().position(|(s, ..)| *s == r.structure) {
+            Some(i) => i,
+            None => {
+                rows.push((&r.structure, Vec::new(), Vec::new()));
+                rows.len() - 1
+            }
+        };
+        if let (Some(i), Some(x)) = (r.build_ratio_interval, r.build_ratio_to_reference) {
+            build_level = build_level.min(i.level);
+            rows[at].2.push((i.relative_half_width(x), r.scene.clone()));
+        }
+        for w in &r.workloads {
+            if let (Some(i), Some(x)) = (w.speedup_interval, w.speedup_vs_reference) {
+                trace_level = trace_level.min(i.level);
+                let place = format!("{} {}", r.scene, w.workload);
+                rows[at].1.push((i.relative_half_width(x), place));
+            }
+        }
+    }
+    if trace_level.is_infinite() && build_level.is_infinite() {
+        return;
+    }
+    let level = |l: f64| {
+        if l.is_finite() {
+            format!("{:.1} %", l * 100.0)
+        } else {
+            "-".into()
+        }
+    };
+    let _ = writeln!(
+        out,
+        "\nRatio precision: each ratio to {} is the median of per-round ratios; half its \
+         confidence interval as ± % of it (coverage: throughput {}, build {}):",
+        report.run.reference,
+        level(trace_level),
+        level(build_level)
+    );
+    let describe = |mut widths: Widths| {
+        if widths.is_empty() {
+            return "-".to_string();
+        }
+        widths.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let median = widths[widths.len() / 2].0;
+        let (widest, at) = &widths[widths.len() - 1];
+        format!(
+            "median ±{:.1} %, widest ±{:.1} % ({at})",
+            median * 100.0,
+            widest * 100.0
+        )
+    };
+    for (structure, traces, builds) in rows {
+        let _ = writeln!(
+            out,
+            "  {structure}: throughput {}; build {}",
+            describe(traces),
+            describe(builds)
+        );
+    }
 }
 
 /// Agreement with the reference per structure (all scenes and workloads) and overall, in the

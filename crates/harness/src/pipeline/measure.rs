@@ -1,17 +1,14 @@
-//! Timing: builds, trace passes and closest-point passes, medians of repeated runs after a
-//! warm-up.
+//! Timing: one trace pass or closest-point pass, and the warm-up passes; `rounds.rs` repeats
+//! them (and the builds) in interleaved rounds.
 //!
 //! Nothing here counts or checks inside a timed region: the trace passes call the structures'
 //! prepared batch path (rays already in each structure's layout), the point passes their batch
 //! closest-point path ([`Accel::closest_points`]), both over the same rayon chunks, and the
 //! counting passes are separate, untimed, single-threaded walks.
 
-use crate::registry::{BuildContext, Built, StructureEntry};
-use crate::report::run::{Throughput, Timing};
-use raybench_accel::{Accel, BuildError, Counters, Hit, PointHit, PreparedRays};
-use raybench_geom::{Ray, TriangleMesh, Vec3};
+use raybench_accel::{Accel, Counters, Hit, PointHit, PreparedRays};
+use raybench_geom::{Ray, Vec3};
 use rayon::prelude::*;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Queries per rayon task when tracing with several threads: large enough that scheduling
@@ -22,51 +19,7 @@ const CHUNK: usize = 256;
 /// long already averages over thousands of scheduler ticks, and repeating it (brute force, or
 /// the BVHs and Embree on `hair` at under 0.1 Mrays/s) took a third of the default suite's time
 /// for precision no ratio needed. The report records the runs.
-const LONG_PASS: Duration = Duration::from_secs(2);
-
-/// Median, minimum and maximum of samples (the median of an even count is the mean of the
-/// middle two).
-pub fn median_min_max(samples: &[f64]) -> (f64, f64, f64) {
-    assert!(!samples.is_empty(), "no samples");
-    let mut s = samples.to_vec();
-    s.sort_by(f64::total_cmp);
-    let mid = s.len() / 2;
-    let median = if s.len().is_multiple_of(2) {
-        (s[mid - 1] + s[mid]) / 2.0
-    } else {
-        s[mid]
-    };
-    (median, s[0], s[s.len() - 1])
-}
-
-/// One warm-up build (which also creates shared state such as Embree's device), then `runs`
-/// timed builds. Returns the last build. Each build's predecessor is dropped outside the
-/// timed window.
-pub fn time_builds(
-    entry: &StructureEntry,
-    mesh: &Arc<TriangleMesh>,
-    ctx: &BuildContext,
-    runs: usize,
-) -> Result<(Built, Timing), BuildError> {
-    let mut built = entry.build(mesh.clone(), ctx)?;
-    let mut ms = Vec::with_capacity(runs);
-    for _ in 0..runs.max(1) {
-        let start = Instant::now();
-        let next = entry.build(mesh.clone(), ctx)?;
-        ms.push(start.elapsed().as_secs_f64() * 1e3);
-        built = next;
-    }
-    let (median_ms, min_ms, max_ms) = median_min_max(&ms);
-    Ok((
-        built,
-        Timing {
-            median_ms,
-            min_ms,
-            max_ms,
-            runs: ms.len(),
-        },
-    ))
-}
+pub(super) const LONG_PASS: Duration = Duration::from_secs(2);
 
 /// Answers of one structure to one workload.
 #[derive(Clone, Debug, PartialEq)]
@@ -136,43 +89,18 @@ pub fn trace_pass(
     start.elapsed()
 }
 
-/// A warm-up pass (whose answers are returned to be checked), then timed passes.
-pub fn time_traces(
+/// The warm-up pass: its answers (checked against the reference) and how long it took (which
+/// decides how many timed passes follow, see `rounds.rs`).
+pub fn warm_up_trace(
     accel: &dyn Accel,
     rays: &[Ray],
     prepared: &PreparedRays,
     any_hit: bool,
     threads: usize,
-    runs: usize,
-) -> (Answers, Throughput) {
+) -> (Answers, Duration) {
     let mut answers = Answers::new(any_hit, rays.len());
-    let warm = trace_pass(accel, rays, prepared, threads, &mut answers);
-    let mut scratch = Answers::new(any_hit, rays.len());
-    let throughput = time_passes(rays.len(), warm, runs, || {
-        trace_pass(accel, rays, prepared, threads, &mut scratch)
-    });
-    (answers, throughput)
-}
-
-/// Millions of queries per second over `runs` timed passes (one when the warm-up took longer
-/// than [`LONG_PASS`]): median, minimum and maximum.
-fn time_passes(
-    queries: usize,
-    warm_up: Duration,
-    runs: usize,
-    mut pass: impl FnMut() -> Duration,
-) -> Throughput {
-    let runs = if warm_up > LONG_PASS { 1 } else { runs.max(1) };
-    let per_pass: Vec<f64> = (0..runs)
-        .map(|_| queries as f64 / pass().as_secs_f64().max(1e-9) / 1e6)
-        .collect();
-    let (median, min, max) = median_min_max(&per_pass);
-    Throughput {
-        median,
-        min,
-        max,
-        runs,
-    }
+    let took = trace_pass(accel, rays, prepared, threads, &mut answers);
+    (answers, took)
 }
 
 /// One closest-point pass over every point through the structure's batch path, like
@@ -195,22 +123,16 @@ pub fn point_pass(
     start.elapsed()
 }
 
-/// A warm-up closest-point pass (whose answers are returned to be checked), then timed
-/// passes: the method of [`time_traces`]. Throughput is in millions of queries per second.
-pub fn time_point_queries(
+/// The warm-up closest-point pass, like [`warm_up_trace`].
+pub fn warm_up_points(
     accel: &dyn Accel,
     points: &[Vec3],
     radius: f32,
     threads: usize,
-    runs: usize,
-) -> (Vec<Option<PointHit>>, Throughput) {
+) -> (Vec<Option<PointHit>>, Duration) {
     let mut answers = vec![None; points.len()];
-    let warm = point_pass(accel, points, radius, threads, &mut answers);
-    let mut scratch = vec![None; points.len()];
-    let throughput = time_passes(points.len(), warm, runs, || {
-        point_pass(accel, points, radius, threads, &mut scratch)
-    });
-    (answers, throughput)
+    let took = point_pass(accel, points, radius, threads, &mut answers);
+    (answers, took)
 }
 
 /// The untimed counted closest-point walk over every point, single-threaded so the counters
@@ -263,15 +185,4 @@ pub fn count_pass(accel: &dyn Accel, rays: &[Ray], any_hit: bool) -> (Answers, C
         )
     };
     (answers, c, per_ray)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn median_of_odd_and_even_counts() {
-        assert_eq!(median_min_max(&[3.0, 1.0, 2.0]), (2.0, 1.0, 3.0));
-        assert_eq!(median_min_max(&[4.0, 1.0, 2.0, 3.0]), (2.5, 1.0, 4.0));
-    }
 }

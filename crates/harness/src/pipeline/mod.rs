@@ -10,6 +10,7 @@ pub mod measure;
 pub mod picture;
 pub mod picture_set;
 pub mod replay;
+mod rounds;
 pub mod run;
 pub mod scenes;
 pub mod verify;

@@ -10,15 +10,15 @@ use super::check::{
 };
 use super::dump::{DumpDir, points_not_dumped};
 use super::images::{PixelInput, PrimaryImage, shade};
-use super::measure::{
-    Answers, count_pass, count_point_pass, time_builds, time_point_queries, time_traces,
-};
+use super::measure::{Answers, count_pass, count_point_pass, warm_up_points, warm_up_trace};
 use super::picture::{self, ScenePicturePass};
+use super::rounds::{self, Job, Pending};
 use super::scenes::for_each_scene;
 use super::workers::{Log, Progress, Workers, catch_panic};
 use super::workloads::{PreparedPoints, QueryCounts, SceneRun, prepare_workload, triangle_counts};
-use crate::registry::{self, BuildContext, Built, StructureEntry};
+use crate::registry::{self, BuildContext, StructureEntry};
 use crate::report::Header;
+use crate::report::interval::{Interval, median_with_interval, paired_ratios};
 use crate::report::run::*;
 use anyhow::Result;
 use raybench_accel::Accel;
@@ -98,7 +98,7 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
     let tol = Tolerance::default();
     let progress = Progress::new(
         opts.progress,
-        (scenes.len() * (structures.len() + 1)) as u64,
+        (scenes.len() * (structures.len() + 2)) as u64,
     );
     let mut report = Report {
         header: Header::new(SCHEMA_VERSION, workers.environment.clone()),
@@ -154,6 +154,7 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
                 }));
                 started.map(|pass| (pass, pool)).map_err(|e| log.errors.push(format!("pictures of {name}: {e:#}"))).ok()
             });
+            let mut pending = Vec::new();
             for entry in &structures {
                 if let Some(limit) = entry.suite_triangle_limit.filter(|&l| opts.suite_limits && scene.scene.mesh.len() > l) {
                     log.notes.push(format!(
@@ -165,22 +166,27 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
                     continue;
                 }
                 progress.step(format!("{name}: {}", entry.name));
-                let built = match catch_panic(|| sr.measure(entry, opts, &tol, dump.as_mut())) {
-                    Ok((r, built)) => {
-                        report.results.push(r);
-                        built
-                    }
+                let p = match catch_panic(|| sr.prepare_entry(entry, opts, &tol, dump.as_mut())) {
+                    Ok(p) => p,
                     Err(e) => {
                         log.errors.push(format!("{} on {name}: {e:#}", entry.name));
                         continue;
                     }
                 };
-                if let Some((p, pool)) = pictures.as_mut() {
+                if let Some((pics, pool)) = pictures.as_mut() {
                     let mesh = &scene.scene.mesh;
-                    let added = catch_panic(|| pool.install(|| p.add(entry.name, built.accel.as_ref(), mesh, sr.reference.as_ref(), &tol)));
+                    let added = catch_panic(|| pool.install(|| pics.add(entry.name, p.built.accel.as_ref(), mesh, sr.reference.as_ref(), &tol)));
                     if let Err(e) = added {
                         log.errors.push(format!("pictures of {} on {name}: {e:#}", entry.name));
                     }
+                }
+                pending.push(p);
+            }
+            progress.step(format!("{name}: timing {} structures in {} interleaved rounds", pending.len(), rounds::rounds(opts)));
+            for (structure, timed) in rounds::time_in_rounds(pending, &sr, opts) {
+                match timed {
+                    Ok(r) => report.results.push(r),
+                    Err(e) => log.errors.push(format!("{structure} on {name}: {e:#}")),
                 }
             }
             if let Some((p, pool)) = pictures {
@@ -206,22 +212,32 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
 }
 
 impl SceneRun<'_> {
-    fn measure(
+    /// Builds `entry` once (the warm-up build, which also creates shared state such as
+    /// Embree's device) and runs everything but the timing: a warm-up pass per workload whose
+    /// answers are checked and dumped, and the counted pass. The timed builds and passes
+    /// follow in rounds (`rounds.rs`).
+    fn prepare_entry<'e>(
         &self,
-        entry: &StructureEntry,
+        entry: &'e StructureEntry,
         opts: &RunOptions,
         tol: &Tolerance,
         mut dump: Option<&mut DumpDir>,
-    ) -> Result<(ResultEntry, Built)> {
+    ) -> Result<Pending<'e>> {
         let s = &self.scene.scene;
         let ctx = BuildContext {
             threads: opts.threads,
         };
-        let (built, build) = time_builds(entry, &s.mesh, &ctx, opts.build_runs)?;
+        let built = entry.build(s.mesh.clone(), &ctx)?;
         let accel = built.accel.as_ref();
+        let mut jobs = Vec::new();
         let mut workloads = Vec::new();
         let mut primary_image = None;
-        for wl in self.workloads.iter().filter(|w| !w.rays.is_empty()) {
+        for (wi, wl) in self
+            .workloads
+            .iter()
+            .enumerate()
+            .filter(|(_, w)| !w.rays.is_empty())
+        {
             let any_hit = wl.workload.any_hit();
             let prepared = prepare_workload(accel, wl.workload, &wl.rays).map_err(|e| {
                 anyhow::anyhow!(
@@ -230,14 +246,8 @@ impl SceneRun<'_> {
                     entry.name
                 )
             })?;
-            let (answers, mrays) = time_traces(
-                accel,
-                &wl.rays,
-                &prepared,
-                any_hit,
-                opts.threads,
-                opts.trace_runs,
-            );
+            let (answers, warm_up) =
+                warm_up_trace(accel, &wl.rays, &prepared, any_hit, opts.threads);
             let (counted, counters, work) = count_pass(accel, &wl.rays, any_hit);
             let sides = Sides {
                 ours: accel,
@@ -270,13 +280,23 @@ impl SceneRun<'_> {
                     .collect();
                 primary_image = Some(PrimaryImage::new(w, h, &pixels));
             }
+            let scratch = Answers::new(any_hit, wl.rays.len());
+            jobs.push(Job::rays(
+                workloads.len(),
+                wi,
+                prepared,
+                scratch,
+                warm_up,
+                opts.trace_runs,
+            ));
             workloads.push(WorkloadResult {
                 workload: wl.workload.name().to_string(),
                 queries: wl.rays.len(),
                 any_hit,
                 point_query: false,
-                mqueries_per_s: mrays,
+                mqueries_per_s: Throughput::from_samples(Vec::new()),
                 speedup_vs_reference: None,
+                speedup_interval: None,
                 counters_per_query: has_counters
                     .then(|| CountersPerQuery::from_total(&counters, wl.rays.len())),
                 counters_total: has_counters.then_some(counters),
@@ -284,21 +304,37 @@ impl SceneRun<'_> {
             });
         }
         let mut not_offered = Vec::new();
-        for pw in self.point_workloads.iter().filter(|w| !w.points.is_empty()) {
+        for (wi, pw) in self
+            .point_workloads
+            .iter()
+            .enumerate()
+            .filter(|(_, w)| !w.points.is_empty())
+        {
             if accel.offers_closest_point() {
-                workloads.push(self.measure_points(accel, pw, opts));
+                let (result, warm_up) = self.check_points(accel, pw, opts);
+                let queries = pw.points.len();
+                jobs.push(Job::points(
+                    workloads.len(),
+                    wi,
+                    queries,
+                    warm_up,
+                    opts.trace_runs,
+                ));
+                workloads.push(result);
             } else {
                 not_offered.push(pw.workload.name().to_string());
             }
         }
         let memory = accel.memory();
-        let entry = ResultEntry {
+        let entry_of = entry;
+        let result = ResultEntry {
             scene: s.name.clone(),
             triangles: triangle_counts(s),
             structure: entry.name.to_string(),
             params: built.params.clone(),
-            build,
+            build: Timing::from_samples(Vec::new()),
             build_ratio_to_reference: None,
+            build_ratio_interval: None,
             memory_bytes: memory.total(),
             memory,
             build_stats: accel.build_stats(),
@@ -306,20 +342,21 @@ impl SceneRun<'_> {
             not_offered,
             primary_image,
         };
-        Ok((entry, built))
+        let mut pending = Pending::new(entry_of, built, result);
+        pending.jobs = jobs;
+        Ok(pending)
     }
 
-    /// One structure on one closest-point workload: timed like rays (warm-up, median of
-    /// `trace_runs` passes on the run's threads), then the counted pass, then the check
-    /// against the reference. Not dumped: `--dump-hits` covers ray workloads only.
-    fn measure_points(
+    /// One structure on one closest-point workload, like rays: the warm-up pass on the run's
+    /// threads (returned with how long it took), then the counted pass, then the check against
+    /// the reference. Not dumped: `--dump-hits` covers ray workloads only.
+    fn check_points(
         &self,
         accel: &dyn Accel,
         pw: &PreparedPoints,
         opts: &RunOptions,
-    ) -> WorkloadResult {
-        let (answers, throughput) =
-            time_point_queries(accel, &pw.points, pw.radius, opts.threads, opts.trace_runs);
+    ) -> (WorkloadResult, std::time::Duration) {
+        let (answers, warm_up) = warm_up_points(accel, &pw.points, pw.radius, opts.threads);
         let (counted, counters) = count_point_pass(accel, &pw.points, pw.radius);
         let mesh = &self.scene.scene.mesh;
         let mut agreement = check_points(
@@ -332,18 +369,20 @@ impl SceneRun<'_> {
         );
         agreement.counted_path_differs = counted_point_differences(&answers, &counted);
         let has_counters = accel.has_counters();
-        WorkloadResult {
+        let result = WorkloadResult {
             workload: pw.workload.name().to_string(),
             queries: pw.points.len(),
             any_hit: false,
             point_query: true,
-            mqueries_per_s: throughput,
+            mqueries_per_s: Throughput::from_samples(Vec::new()),
             speedup_vs_reference: None,
+            speedup_interval: None,
             counters_per_query: has_counters
                 .then(|| CountersPerQuery::from_total(&counters, pw.points.len())),
             counters_total: has_counters.then_some(counters),
             agreement,
-        }
+        };
+        (result, warm_up)
     }
 }
 
@@ -359,7 +398,8 @@ fn unique_base(used: &mut std::collections::HashSet<String>, scene: &str) -> Str
     candidate
 }
 
-/// Ratios to the reference measured in the same run: build time and throughput per workload.
+/// Ratios to the reference measured in the same run: build time and throughput per workload,
+/// each the median of the per-round ratios with its interval (see `report/interval.rs`).
 fn fill_ratios(report: &mut Report) {
     let reference = report.run.reference.clone();
     let refs: Vec<ResultEntry> = report
@@ -372,13 +412,38 @@ fn fill_ratios(report: &mut Report) {
         let Some(base) = refs.iter().find(|b| b.scene == r.scene) else {
             continue;
         };
-        r.build_ratio_to_reference =
-            (base.build.median_ms > 0.0).then(|| r.build.median_ms / base.build.median_ms);
+        (r.build_ratio_to_reference, r.build_ratio_interval) = ratio(
+            (r.build.median_ms, &r.build.samples_ms),
+            (base.build.median_ms, &base.build.samples_ms),
+        );
         for w in &mut r.workloads {
-            let base_w = base.workloads.iter().find(|b| b.workload == w.workload);
-            w.speedup_vs_reference = base_w
-                .filter(|b| b.mqueries_per_s.median > 0.0)
-                .map(|b| w.mqueries_per_s.median / b.mqueries_per_s.median);
+            let Some(b) = base.workloads.iter().find(|b| b.workload == w.workload) else {
+                continue;
+            };
+            let (ours, theirs) = (&w.mqueries_per_s, &b.mqueries_per_s);
+            (w.speedup_vs_reference, w.speedup_interval) = ratio(
+                (ours.median, &ours.samples),
+                (theirs.median, &theirs.samples),
+            );
         }
+    }
+}
+
+/// `a / b` as the median of the per-round ratios with its interval when both sides have two
+/// samples or more, else the ratio of the medians; `None` when `b` is not positive.
+fn ratio(
+    (a, a_samples): (f64, &[f64]),
+    (b, b_samples): (f64, &[f64]),
+) -> (Option<f64>, Option<Interval>) {
+    if b <= 0.0 {
+        return (None, None);
+    }
+    let paired = paired_ratios(a_samples, b_samples);
+    if a_samples.len() < 2 || b_samples.len() < 2 {
+        return (Some(a / b), None);
+    }
+    match median_with_interval(&paired) {
+        Some((median, interval)) => (Some(median), interval),
+        None => (Some(a / b), None),
     }
 }

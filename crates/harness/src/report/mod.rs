@@ -5,6 +5,7 @@
 pub mod agreement;
 pub mod claims;
 pub mod compare;
+pub mod interval;
 pub mod run;
 pub mod verify;
 pub mod watertight;

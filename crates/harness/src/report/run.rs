@@ -104,8 +104,13 @@ pub struct ResultEntry {
     pub structure: String,
     pub params: serde_json::Value,
     pub build: Timing,
-    /// Build median divided by the reference's build median in this run.
+    /// Build time divided by the reference's in this run: the median of the per-round ratios
+    /// (the ratio of the medians in reports without samples).
     pub build_ratio_to_reference: Option<f64>,
+    /// Its confidence interval over the rounds (absent with fewer than two rounds, and in
+    /// older reports).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub build_ratio_interval: Option<super::interval::Interval>,
     pub memory_bytes: u64,
     pub memory: Memory,
     pub build_stats: BuildStats,
@@ -120,20 +125,64 @@ pub struct ResultEntry {
 }
 
 /// Wall-clock build time over `runs` builds after one warm-up build.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Timing {
     pub median_ms: f64,
     pub min_ms: f64,
     pub max_ms: f64,
     pub runs: usize,
+    /// Every timed build, in round order (absent in older reports).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub samples_ms: Vec<f64>,
 }
 
-#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+/// Millions of queries per second over `runs` timed passes after one warm-up pass.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Throughput {
     pub median: f64,
     pub min: f64,
     pub max: f64,
     pub runs: usize,
+    /// Every timed pass, in round order (absent in older reports).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub samples: Vec<f64>,
+}
+
+impl Timing {
+    pub fn from_samples(samples_ms: Vec<f64>) -> Timing {
+        let (median_ms, min_ms, max_ms) = median_min_max(&samples_ms);
+        Timing {
+            median_ms,
+            min_ms,
+            max_ms,
+            runs: samples_ms.len(),
+            samples_ms,
+        }
+    }
+}
+
+impl Throughput {
+    pub fn from_samples(samples: Vec<f64>) -> Throughput {
+        let (median, min, max) = median_min_max(&samples);
+        Throughput {
+            median,
+            min,
+            max,
+            runs: samples.len(),
+            samples,
+        }
+    }
+}
+
+/// Median, minimum and maximum of samples (the median of an even count is the mean of the
+/// middle two); zeros for none.
+pub fn median_min_max(samples: &[f64]) -> (f64, f64, f64) {
+    let Some((median, _)) = super::interval::median_with_interval(samples) else {
+        return (0.0, 0.0, 0.0);
+    };
+    let min = samples.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = samples.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (median, min, max)
 }
 
 /// One structure on one workload. A query is a ray in a ray workload and a point in a
@@ -154,8 +203,14 @@ pub struct WorkloadResult {
     /// Millions of queries per second: rays, or closest-point queries when `point_query`.
     #[serde(alias = "mrays_per_s")]
     pub mqueries_per_s: Throughput,
-    /// Median throughput divided by the reference's in this run (> 1: faster than reference).
+    /// Throughput divided by the reference's in this run (> 1: faster than reference): the
+    /// median of the per-round ratios (the ratio of the medians in reports without samples,
+    /// and when either side was timed once).
     pub speedup_vs_reference: Option<f64>,
+    /// Its confidence interval over the rounds (absent when either side was timed once, and
+    /// in older reports).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speedup_interval: Option<super::interval::Interval>,
     /// `None` for structures that cannot count their work (Embree).
     #[serde(alias = "counters_per_ray")]
     pub counters_per_query: Option<CountersPerQuery>,

@@ -1,0 +1,204 @@
+//! Interleaved timing. Every structure of a scene is first built, traced once and checked
+//! (`run.rs`); only then is anything timed, in rounds: round `r` builds each structure once and
+//! traces each of its workloads once, the structures in an order rotated by `r`. On a shared
+//! machine a slow spell then lands on every structure alike instead of on whichever one was
+//! being timed, and each round's ratio to the reference compares passes run moments apart.
+//! Every timed pass is kept (the report's `samples`); the ratio to the reference is the median
+//! of the per-round ratios, with a confidence interval ([`super::interval`]).
+//!
+//! The price is memory: all of a scene's structures (and their prepared rays) are alive
+//! together, where measuring one after the other held one at a time.
+
+use super::measure::{Answers, LONG_PASS, point_pass, trace_pass};
+use super::run::RunOptions;
+use super::workers::catch_panic;
+use super::workloads::SceneRun;
+use crate::registry::{BuildContext, Built, StructureEntry};
+use crate::report::run::{ResultEntry, Throughput, Timing};
+use anyhow::Result;
+use raybench_accel::{PointHit, PreparedRays};
+use std::time::{Duration, Instant};
+
+/// One structure of a scene, built and checked, waiting for its timed passes.
+pub(super) struct Pending<'e> {
+    pub entry: &'e StructureEntry,
+    /// The warm-up build: the one every pass traces.
+    pub built: Built,
+    /// Everything but the timings, which [`finish`] fills in.
+    pub result: ResultEntry,
+    pub jobs: Vec<Job>,
+    build_ms: Vec<f64>,
+}
+
+/// One workload of a [`Pending`] structure: what a timed pass needs, and its samples.
+pub(super) struct Job {
+    /// Its place in the result's `workloads`.
+    result_index: usize,
+    kind: JobKind,
+    /// Timed passes: `trace_runs`, or one when the warm-up took longer than [`LONG_PASS`].
+    runs: usize,
+    /// Millions of queries per second, one per timed pass, in round order.
+    samples: Vec<f64>,
+}
+
+enum JobKind {
+    /// `workload` indexes the scene's ray workloads.
+    Rays {
+        workload: usize,
+        prepared: PreparedRays,
+        scratch: Answers,
+    },
+    /// `workload` indexes the scene's closest-point workloads.
+    Points {
+        workload: usize,
+        scratch: Vec<Option<PointHit>>,
+    },
+}
+
+impl Job {
+    /// A ray workload whose warm-up pass took `warm_up`.
+    pub(super) fn rays(
+        result_index: usize,
+        workload: usize,
+        prepared: PreparedRays,
+        scratch: Answers,
+        warm_up: Duration,
+        trace_runs: usize,
+    ) -> Job {
+        Job {
+            result_index,
+            kind: JobKind::Rays {
+                workload,
+                prepared,
+                scratch,
+            },
+            runs: runs_after(warm_up, trace_runs),
+            samples: Vec::new(),
+        }
+    }
+
+    /// A closest-point workload whose warm-up pass took `warm_up`.
+    pub(super) fn points(
+        result_index: usize,
+        workload: usize,
+        queries: usize,
+        warm_up: Duration,
+        trace_runs: usize,
+    ) -> Job {
+        Job {
+            result_index,
+            kind: JobKind::Points {
+                workload,
+                scratch: vec![None; queries],
+            },
+            runs: runs_after(warm_up, trace_runs),
+            samples: Vec::new(),
+        }
+    }
+}
+
+/// A warm-up pass longer than [`LONG_PASS`] is measured once more, not `trace_runs` times.
+fn runs_after(warm_up: Duration, trace_runs: usize) -> usize {
+    if warm_up > LONG_PASS {
+        1
+    } else {
+        trace_runs.max(1)
+    }
+}
+
+impl<'e> Pending<'e> {
+    pub(super) fn new(entry: &'e StructureEntry, built: Built, result: ResultEntry) -> Self {
+        Pending {
+            entry,
+            built,
+            result,
+            jobs: Vec::new(),
+            build_ms: Vec::new(),
+        }
+    }
+
+    /// Round `r`: one timed build (the new structure is dropped outside the timed window) while
+    /// `r < build_runs`, and one timed pass of each workload that still has runs left.
+    fn round(&mut self, r: usize, sr: &SceneRun, opts: &RunOptions) -> Result<()> {
+        let mesh = &sr.scene.scene.mesh;
+        if r < opts.build_runs.max(1) {
+            let ctx = BuildContext {
+                threads: opts.threads,
+            };
+            let start = Instant::now();
+            let next = self.entry.build(mesh.clone(), &ctx)?;
+            self.build_ms.push(start.elapsed().as_secs_f64() * 1e3);
+            drop(next);
+        }
+        let accel = self.built.accel.as_ref();
+        for job in self.jobs.iter_mut().filter(|j| r < j.runs) {
+            let (queries, took) = match &mut job.kind {
+                JobKind::Rays {
+                    workload,
+                    prepared,
+                    scratch,
+                } => {
+                    let rays = &sr.workloads[*workload].rays;
+                    let took = trace_pass(accel, rays, prepared, opts.threads, scratch);
+                    (rays.len(), took)
+                }
+                JobKind::Points { workload, scratch } => {
+                    let pw = &sr.point_workloads[*workload];
+                    let took = point_pass(accel, &pw.points, pw.radius, opts.threads, scratch);
+                    (pw.points.len(), took)
+                }
+            };
+            job.samples
+                .push(queries as f64 / took.as_secs_f64().max(1e-9) / 1e6);
+        }
+        Ok(())
+    }
+
+    /// The result with its timings from the samples.
+    fn finish(mut self) -> ResultEntry {
+        self.result.build = Timing::from_samples(self.build_ms);
+        for job in self.jobs {
+            self.result.workloads[job.result_index].mqueries_per_s =
+                Throughput::from_samples(job.samples);
+        }
+        self.result
+    }
+}
+
+/// How many rounds a run's settings take: enough for every timed build and pass.
+pub(super) fn rounds(opts: &RunOptions) -> usize {
+    opts.build_runs.max(opts.trace_runs).max(1)
+}
+
+/// Times every pending structure in interleaved rounds and returns, in the order given, each
+/// structure's name with its result or what went wrong (a failed build or a panic in any round
+/// takes that structure out of the later rounds; the others go on).
+pub(super) fn time_in_rounds(
+    pending: Vec<Pending<'_>>,
+    sr: &SceneRun,
+    opts: &RunOptions,
+) -> Vec<(&'static str, Result<ResultEntry>)> {
+    let n = pending.len();
+    let mut failed: Vec<Option<anyhow::Error>> = (0..n).map(|_| None).collect();
+    let mut pending = pending;
+    for r in 0..rounds(opts) {
+        for k in 0..n {
+            let i = (k + r) % n;
+            if failed[i].is_some() {
+                continue;
+            }
+            let p = &mut pending[i];
+            if let Err(e) = catch_panic(|| p.round(r, sr, opts)) {
+                failed[i] = Some(e.context(format!("timing round {}", r + 1)));
+            }
+        }
+    }
+    pending
+        .into_iter()
+        .zip(failed)
+        .map(|(p, f)| match f {
+            None => (p.entry.name, Ok(p.finish())),
+            Some(e) => (p.entry.name, Err(e)),
+        })
+        .collect()
+}
