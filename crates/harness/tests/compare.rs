@@ -3,8 +3,10 @@
 
 mod common;
 
+use raybench_harness::output::compare_table::full_table;
 use raybench_harness::pipeline::run::run;
-use raybench_harness::report::compare::{CompareOptions, Severity, compare};
+use raybench_harness::report::compare::{CompareOptions, Comparison, Severity, compare};
+use raybench_harness::report::interval::Interval;
 use raybench_harness::report::run::Report;
 use raybench_scenes::SceneRequest;
 use std::path::Path;
@@ -34,6 +36,12 @@ fn regressions(new: &Report, opts: &CompareOptions) -> Vec<String> {
         .collect()
 }
 
+/// Every finding and every row, as the Markdown writes them.
+fn text(c: &Comparison) -> String {
+    let findings: Vec<&str> = c.findings.iter().map(|f| f.what.as_str()).collect();
+    format!("{}\n{}", findings.join("\n"), full_table(c))
+}
+
 fn bvh(report: &mut Report) -> &mut raybench_harness::report::run::ResultEntry {
     report
         .results
@@ -45,12 +53,9 @@ fn bvh(report: &mut Report) -> &mut raybench_harness::report::run::ResultEntry {
 #[test]
 fn identical_reports_have_no_regression() {
     let c = compare(base(), base(), &CompareOptions::default());
-    assert_eq!(c.regressions(), 0, "{}", c.markdown);
-    assert!(
-        c.markdown
-            .contains("| soup:triangles=300 | bvh-binned | primary |")
-    );
-    assert!(c.markdown.contains("same"), "{}", c.markdown);
+    assert_eq!(c.regressions(), 0, "{}", text(&c));
+    assert!(text(&c).contains("| soup:triangles=300 | bvh-binned | primary |"));
+    assert!(text(&c).contains("same"), "{}", text(&c));
 }
 
 #[test]
@@ -85,25 +90,104 @@ fn a_new_mismatch_is_a_regression() {
 
 #[test]
 fn a_slowdown_beyond_the_threshold_fails_unless_advisory() {
+    let s = bvh(&mut base().clone()).workloads[0]
+        .speedup_vs_reference
+        .unwrap();
+    // Narrow intervals around both ratios: the slowdown is significant.
+    let narrow = |x: f64| Interval {
+        lo: x * 0.99,
+        hi: x * 1.01,
+        level: 0.9375,
+    };
+    let old = with_base_interval(narrow(s));
     let mut new = base().clone();
     let w = &mut bvh(&mut new).workloads[0];
-    let s = w.speedup_vs_reference.unwrap();
     w.speedup_vs_reference = Some(s / 1.2); // 20 % slower
+    w.speedup_interval = Some(narrow(s / 1.2));
+    let regressions = |opts: &CompareOptions| compare(&old, &new, opts).regressions();
     let strict = CompareOptions::default();
-    let r = regressions(&new, &strict);
-    assert!(r.iter().any(|x| x.contains("Mrays/s ratio")), "{r:?}");
+    let c = compare(&old, &new, &strict);
+    assert!(
+        c.findings.iter().any(|f| f.what.contains("Mrays/s ratio")),
+        "{}",
+        text(&c)
+    );
+    assert_eq!(regressions(&strict), 1, "{}", text(&c));
     let lenient = CompareOptions {
         max_slowdown: 0.25,
         ..strict
     };
-    assert!(regressions(&new, &lenient).is_empty());
+    assert_eq!(regressions(&lenient), 0);
     let advisory = CompareOptions {
         timing_advisory: true,
         ..strict
     };
-    let c = compare(base(), &new, &advisory);
+    let c = compare(&old, &new, &advisory);
     assert_eq!(c.regressions(), 0);
     assert!(c.findings.iter().any(|f| f.severity == Severity::Advisory));
+}
+
+/// The base report with `interval` as bvh-binned's first workload's ratio interval.
+fn with_base_interval(interval: Interval) -> Report {
+    let mut b = base().clone();
+    bvh(&mut b).workloads[0].speedup_interval = Some(interval);
+    b
+}
+
+#[test]
+fn a_slowdown_within_the_noise_is_advisory_and_a_significant_one_fails() {
+    let s = bvh(&mut base().clone()).workloads[0]
+        .speedup_vs_reference
+        .unwrap();
+    let interval = |x: f64, half: f64| Interval {
+        lo: x * (1.0 - half),
+        hi: x * (1.0 + half),
+        level: 0.9375,
+    };
+    let judge = |half: f64| {
+        let mut new = base().clone();
+        let w = &mut bvh(&mut new).workloads[0];
+        w.speedup_vs_reference = Some(s / 1.3); // 30 % slower
+        w.speedup_interval = Some(interval(s / 1.3, half));
+        let c = compare(
+            &with_base_interval(interval(s, half)),
+            &new,
+            &CompareOptions::default(),
+        );
+        let f = c
+            .findings
+            .iter()
+            .find(|f| f.what.contains("Mrays/s ratio"))
+            .cloned();
+        (c.regressions(), f.expect("a finding about the slowdown"))
+    };
+    // ±2 %: even the most favourable ends are 25 % apart, beyond 10 %.
+    let (regressions, f) = judge(0.02);
+    assert_eq!(regressions, 1, "{f:?}");
+    assert!(
+        f.what.contains("30.0 % slower") && f.what.contains("significant"),
+        "{f:?}"
+    );
+    // ±15 %: the ends overlap the threshold, so it is not significant.
+    let (regressions, f) = judge(0.15);
+    assert_eq!(regressions, 0, "{f:?}");
+    assert_eq!(f.severity, Severity::Advisory);
+    assert!(f.what.contains("not significant"), "{f:?}");
+}
+
+#[test]
+fn a_subset_counts_what_it_did_not_run_as_not_run() {
+    let mut new = base().clone();
+    new.results.retain(|r| r.structure != "bruteforce");
+    let strict = compare(base(), &new, &CompareOptions::default());
+    assert!(strict.regressions() > 0);
+    let subset = CompareOptions {
+        subset: true,
+        ..CompareOptions::default()
+    };
+    let c = compare(base(), &new, &subset);
+    assert_eq!(c.regressions(), 0, "{}", text(&c));
+    assert!(c.findings.iter().any(|f| f.what.contains("not run")));
 }
 
 #[test]
@@ -155,14 +239,14 @@ fn different_settings_and_machines_are_flagged() {
     new.header.environment.cpu_model = "Another CPU".into();
     let c = compare(base(), &new, &CompareOptions::default());
     assert!(
-        c.markdown.contains("WARNING: different environments (CPU"),
+        text(&c).contains("WARNING: different environments (CPU"),
         "{}",
-        c.markdown
+        text(&c)
     );
     assert!(
-        c.markdown.contains("different run settings (seed"),
+        text(&c).contains("different run settings (seed"),
         "{}",
-        c.markdown
+        text(&c)
     );
     assert!(c.regressions() > 0);
 }
@@ -250,8 +334,8 @@ fn a_schema_1_report_reads_through_the_old_names() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("report.json");
     std::fs::write(&path, serde_json::to_vec_pretty(&old).unwrap()).unwrap();
-    let text = std::fs::read_to_string(&path).unwrap();
-    assert!(text.contains("\"mrays_per_s\"") && !text.contains("\"mqueries_per_s\""));
+    let written = std::fs::read_to_string(&path).unwrap();
+    assert!(written.contains("\"mrays_per_s\"") && !written.contains("\"mqueries_per_s\""));
     let read = Report::read(&path).expect("a schema-1 report reads");
     assert_eq!(read.header.schema_version, 1);
     let mut same = read.clone();
@@ -261,9 +345,74 @@ fn a_schema_1_report_reads_through_the_old_names() {
         serde_json::to_string(base()).unwrap()
     );
     let c = compare(&read, base(), &CompareOptions::default());
-    assert_eq!(c.regressions(), 0, "{}", c.markdown);
+    assert_eq!(c.regressions(), 0, "{}", text(&c));
     // The baseline CI compares against loads whatever version it was written with.
     let baseline = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/baseline/ci.json");
     Report::read(&baseline).expect("reports/baseline/ci.json reads");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_ci_baseline_against_itself_fits_a_pull_request_comment_verdict_first() {
+    use raybench_harness::output::compare_table::{MARKDOWN_LIMIT, MarkdownLimits, markdown};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/baseline/ci.json");
+    let ci = Report::read(&path).expect("reports/baseline/ci.json reads");
+    let opts = CompareOptions::default();
+    let c = compare(&ci, &ci, &opts);
+    assert_eq!(c.regressions(), 0);
+    assert!(c.rows.len() > 500, "{} rows", c.rows.len());
+    let limits = MarkdownLimits {
+        max_rows: 40,
+        max_findings: 25,
+        only_changed: false,
+    };
+    let md = markdown(&ci, &ci, &c, &opts, &limits, None);
+    assert!(
+        md.starts_with("## raybench compare: PASS"),
+        "{}",
+        &md[..200]
+    );
+    assert!(md.len() < MARKDOWN_LIMIT, "{} characters", md.len());
+    // Nothing changed: with --only-changed the table is empty.
+    let only = MarkdownLimits {
+        only_changed: true,
+        ..limits
+    };
+    let md = markdown(&ci, &ci, &c, &opts, &only, None);
+    assert!(
+        md.contains(&format!("0 of {} rows (changed only)", c.rows.len())),
+        "{md}"
+    );
+    // Even every row cannot pass the limit.
+    let all = MarkdownLimits {
+        max_rows: usize::MAX,
+        ..limits
+    };
+    assert!(markdown(&ci, &ci, &c, &opts, &all, None).len() <= MARKDOWN_LIMIT + 200);
+}
+
+#[test]
+fn json_and_junit_carry_the_verdict_and_the_failing_row() {
+    use raybench_harness::output::compare_table::{json, junit};
+    let mut new = base().clone();
+    bvh(&mut new).workloads[0]
+        .counters_total
+        .as_mut()
+        .unwrap()
+        .nodes += 1;
+    let opts = CompareOptions::default();
+    let c = compare(base(), &new, &opts);
+    let v: serde_json::Value = serde_json::from_str(&json(&c, &opts, true)).unwrap();
+    assert_eq!(v["verdict"], "fail");
+    assert_eq!(v["regressions"], 1);
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 1, "only the changed row: {rows:?}");
+    assert_eq!(rows[0]["counters"], "CHANGED");
+    let xml = junit(&c);
+    assert!(xml.contains("failures=\"1\""), "{xml}");
+    assert!(xml.contains("counters changed"), "{xml}");
+    let same = compare(base(), base(), &opts);
+    let v: serde_json::Value = serde_json::from_str(&json(&same, &opts, false)).unwrap();
+    assert_eq!(v["verdict"], "pass");
+    assert!(junit(&same).contains("failures=\"0\""));
 }

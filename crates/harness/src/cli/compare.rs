@@ -1,11 +1,26 @@
-//! `raybench compare`: the diff of two reports as Markdown; exit 2 on a regression.
+//! `raybench compare`: the diff of two reports as Markdown, JSON or JUnit XML; exit 2 on a
+//! regression.
 
+use crate::output::compare_table::{MarkdownLimits, full_table, json, junit, markdown};
 use crate::report::compare::{CompareOptions, compare};
 use crate::report::run::Report;
-use anyhow::Result;
-use clap::Args;
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
+
+/// The most rows or findings `--max-rows` and `--max-findings` accept.
+const MAX_LIMIT: usize = 1_000_000;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Format {
+    /// Verdict, findings and the worst rows, sized for a pull-request comment.
+    Md,
+    /// Verdict, every finding and every row, for scripts.
+    Json,
+    /// JUnit XML: a test case per row, failed by its regressions.
+    Junit,
+}
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
@@ -13,28 +28,75 @@ pub struct CompareArgs {
     base: PathBuf,
     /// The report.json to judge.
     new: PathBuf,
-    /// A timing ratio to the reference worse by more than this percentage is a regression.
+    /// A timing ratio to the reference worse by more than this percentage is a regression
+    /// (when significant: see the command's documentation).
     #[arg(long, default_value_t = 10.0)]
     max_slowdown: f64,
-    /// Print timing slowdowns without failing on them (for CI on shared machines).
+    /// Print timing slowdowns without failing on them.
     #[arg(long)]
     timing_advisory: bool,
+    /// The new report ran part of the base on purpose: entries and workloads it lacks are
+    /// "not run", not regressions.
+    #[arg(long)]
+    subset: bool,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Md)]
+    format: Format,
+    /// Only rows where something changed (counters, mismatches, a ratio beyond the threshold).
+    #[arg(long)]
+    only_changed: bool,
+    /// Markdown: rows shown, worst first.
+    #[arg(long, default_value_t = 40)]
+    max_rows: usize,
+    /// Markdown: findings shown per severity.
+    #[arg(long, default_value_t = 25)]
+    max_findings: usize,
+    /// Also write every row as a Markdown table to this file.
+    #[arg(long)]
+    full_table: Option<PathBuf>,
 }
 
 pub fn run(args: CompareArgs) -> Result<ExitCode> {
     anyhow::ensure!(
-        args.max_slowdown.is_finite() && args.max_slowdown >= 0.0,
-        "--max-slowdown must be a percentage >= 0 (got {})",
+        args.max_slowdown.is_finite() && args.max_slowdown >= 0.0 && args.max_slowdown <= 1e6,
+        "--max-slowdown must be a percentage from 0 to 1e6 (got {})",
         args.max_slowdown
     );
+    for (flag, v) in [
+        ("--max-rows", args.max_rows),
+        ("--max-findings", args.max_findings),
+    ] {
+        anyhow::ensure!(
+            v <= MAX_LIMIT,
+            "{flag} must be at most {MAX_LIMIT} (got {v})"
+        );
+    }
     let base = Report::read(&args.base)?;
     let new = Report::read(&args.new)?;
     let opts = CompareOptions {
         max_slowdown: args.max_slowdown / 100.0,
         timing_advisory: args.timing_advisory,
+        subset: args.subset,
     };
     let c = compare(&base, &new, &opts);
-    print!("{}", c.markdown);
+    if let Some(path) = &args.full_table {
+        crate::atomic::write_atomic(path, full_table(&c).as_bytes())
+            .with_context(|| format!("--full-table {}", path.display()))?;
+    }
+    let text = match args.format {
+        Format::Md => {
+            let limits = MarkdownLimits {
+                max_rows: args.max_rows,
+                max_findings: args.max_findings,
+                only_changed: args.only_changed,
+            };
+            let table = args.full_table.as_ref().map(|p| p.display().to_string());
+            markdown(&base, &new, &c, &opts, &limits, table.as_deref())
+        }
+        Format::Json => json(&c, &opts, args.only_changed),
+        Format::Junit => junit(&c),
+    };
+    print!("{text}");
     Ok(if c.regressions() > 0 {
         eprintln!("raybench compare: {} regression(s)", c.regressions());
         ExitCode::from(2)

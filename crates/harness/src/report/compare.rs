@@ -8,14 +8,21 @@
 //!   the same seed gives the same numbers on every machine and thread count, so any change
 //!   fails (it is a change of algorithm, and the baseline must be regenerated on purpose);
 //! * **timing** — only as ratios to the reference measured in the same run (build time ratio,
-//!   Mrays/s ratio), which cancels most of the machine; a ratio worse by more than
-//!   `max_slowdown` fails unless timing is advisory (CI shares its machine).
+//!   Mrays/s ratio), which cancels most of the machine. A change is written one way everywhere,
+//!   as a slowdown: how much longer a query (or the build) takes relative to the reference,
+//!   `base / new - 1` for throughput ratios and `new / base - 1` for build ratios. When both
+//!   reports carry confidence intervals for the ratios (per-round samples, see
+//!   `report/interval.rs`), a slowdown is a regression only if it is significant: the most
+//!   favourable end of its interval is still beyond `max_slowdown`. Otherwise (reports
+//!   without samples) the median alone decides, as a point test. Timing fails unless advisory.
 //!
 //! Entries in the base that the new report lacks fail too (a structure that stopped building is
-//! not "no regression"); entries only in the new report are listed as new.
+//! not "no regression"), unless the comparison is of a subset (`subset`): then they are "not
+//! run" notes. Entries only in the new report are listed as new.
 
+use super::interval::Interval;
 use super::run::{Report, ResultEntry, WorkloadResult, is_point_workload, throughput_unit};
-use crate::output::compare_table::{markdown, row};
+use crate::output::compare_table::{Row, row};
 use std::collections::BTreeMap;
 
 /// How to judge timing ratios.
@@ -25,6 +32,9 @@ pub struct CompareOptions {
     pub max_slowdown: f64,
     /// Print slowdowns but do not fail on them.
     pub timing_advisory: bool,
+    /// The new report ran part of the base's scenes, structures or workloads on purpose:
+    /// what it lacks is "not run", not a regression.
+    pub subset: bool,
 }
 
 impl Default for CompareOptions {
@@ -32,6 +42,7 @@ impl Default for CompareOptions {
         CompareOptions {
             max_slowdown: 0.10,
             timing_advisory: false,
+            subset: false,
         }
     }
 }
@@ -51,12 +62,26 @@ pub enum Severity {
 pub struct Finding {
     pub severity: Severity,
     pub what: String,
+    /// What it is about: `scene / structure / workload`, `scene / structure`, or empty for
+    /// the reports as a whole.
+    pub at: String,
 }
 
-/// The result of a comparison: the Markdown to print and the findings.
+impl Finding {
+    fn about(severity: Severity, at: impl Into<String>, what: String) -> Finding {
+        Finding {
+            severity,
+            what,
+            at: at.into(),
+        }
+    }
+}
+
+/// The result of a comparison: the rows side by side and the findings (worst first), drawn
+/// by [`crate::output::compare_table`].
 #[derive(Debug)]
 pub struct Comparison {
-    pub markdown: String,
+    pub rows: Vec<Row>,
     pub findings: Vec<Finding>,
 }
 
@@ -102,21 +127,23 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
     let mut findings = Vec::new();
     for (which, report) in [("base", base), ("new", new)] {
         for twice in duplicate_entries(report) {
-            findings.push(Finding {
-                severity: Severity::Regression,
-                what: format!(
+            findings.push(Finding::about(
+                Severity::Regression,
+                twice.clone(),
+                format!(
                     "the {which} report lists {twice} more than once: a report with duplicate \
                      entries cannot be compared (one copy would hide the other)"
                 ),
-            });
+            ));
         }
     }
-    let comparable = environment_warnings(base, new, &mut findings);
+    let comparable = environment_warnings(base, new, opts, &mut findings);
     for e in &new.errors {
-        findings.push(Finding {
-            severity: Severity::Regression,
-            what: format!("the new report has an error: {e}"),
-        });
+        findings.push(Finding::about(
+            Severity::Regression,
+            "",
+            format!("the new report has an error: {e}"),
+        ));
     }
     // Shadow, diffuse and Whitted rays are generated from the reference's hits: with another
     // Embree build or ISA they may differ by an ulp, and so may the counters they produce.
@@ -125,15 +152,19 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
         && base.header.environment.embree.isa == new.header.environment.embree.isa;
     let (b, n) = (keyed(base), keyed(new));
     let mut rows = Vec::new();
+    let mut not_run = 0usize;
     for (key, be) in &b {
+        let at = format!("{} / {}", key.0, key.1);
         let Some(ne) = n.get(key) else {
-            findings.push(Finding {
-                severity: Severity::Regression,
-                what: format!(
-                    "{} / {}: in the base, missing from the new report",
-                    key.0, key.1
-                ),
-            });
+            if opts.subset {
+                not_run += 1;
+            } else {
+                findings.push(Finding::about(
+                    Severity::Regression,
+                    at.clone(),
+                    format!("{at}: in the base, missing from the new report"),
+                ));
+            }
             continue;
         };
         if comparable {
@@ -141,17 +172,19 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
         }
         compare_build_time(be, ne, opts, &mut findings);
         for bw in &be.workloads {
+            let label = format!("{at} / {}", bw.workload);
             let Some(nw) = ne.workloads.iter().find(|w| w.workload == bw.workload) else {
-                findings.push(Finding {
-                    severity: Severity::Regression,
-                    what: format!(
-                        "{} / {} / {}: workload missing from the new report",
-                        key.0, key.1, bw.workload
-                    ),
-                });
+                if opts.subset {
+                    not_run += 1;
+                } else {
+                    findings.push(Finding::about(
+                        Severity::Regression,
+                        label.clone(),
+                        format!("{label}: workload missing from the new report"),
+                    ));
+                }
                 continue;
             };
-            let label = format!("{} / {} / {}", key.0, key.1, bw.workload);
             let is_reference = key.1 == new.run.reference;
             // Query points, like primary and random rays, depend on the scene and seed only.
             let independent_rays =
@@ -166,23 +199,39 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
                 opts,
                 &mut findings,
             );
-            rows.push(row(be, ne, bw, nw, comparable));
+            rows.push(row(be, ne, bw, nw, comparable, opts));
         }
     }
+    if not_run > 0 {
+        findings.push(Finding::about(
+            Severity::Note,
+            "",
+            format!(
+                "{not_run} entries or workloads of the base were not run in the new report \
+                 (compared as a subset)"
+            ),
+        ));
+    }
     for key in n.keys().filter(|k| !b.contains_key(*k)) {
-        findings.push(Finding {
-            severity: Severity::Note,
-            what: format!("{} / {}: new in this report (no baseline)", key.0, key.1),
-        });
+        let at = format!("{} / {}", key.0, key.1);
+        findings.push(Finding::about(
+            Severity::Note,
+            at.clone(),
+            format!("{at}: new in this report (no baseline)"),
+        ));
     }
     findings.sort_by_key(|f| f.severity);
-    let markdown = markdown(base, new, &rows, &findings, opts);
-    Comparison { markdown, findings }
+    Comparison { rows, findings }
 }
 
 /// Warns about different machines and settings; returns whether deterministic figures are
 /// comparable (same seed, rays, workloads, suite and reference).
-fn environment_warnings(base: &Report, new: &Report, findings: &mut Vec<Finding>) -> bool {
+fn environment_warnings(
+    base: &Report,
+    new: &Report,
+    opts: &CompareOptions,
+    findings: &mut Vec<Finding>,
+) -> bool {
     let (be, ne) = (&base.header.environment, &new.header.environment);
     let machine = [
         ("CPU", be.cpu_model.clone(), ne.cpu_model.clone()),
@@ -202,6 +251,7 @@ fn environment_warnings(base: &Report, new: &Report, findings: &mut Vec<Finding>
         if b != n {
             findings.push(Finding {
                 severity: Severity::Note,
+                at: String::new(),
                 what: format!(
                     "WARNING: different environments ({what}: base `{b}`, new `{n}`): timing ratios \
                      are less comparable"
@@ -219,12 +269,13 @@ fn environment_warnings(base: &Report, new: &Report, findings: &mut Vec<Finding>
     if ran_points(base) {
         settings.push(("points", br.points.to_string(), nr.points.to_string()));
     }
-    let mut comparable = workloads_comparable(&br.workloads, &nr.workloads, findings);
+    let mut comparable = workloads_comparable(&br.workloads, &nr.workloads, opts, findings);
     for (what, b, n) in settings {
         if b != n {
             comparable = false;
             findings.push(Finding {
                 severity: Severity::Regression,
+                at: String::new(),
                 what: format!(
                     "different run settings ({what}: base `{b}`, new `{n}`): deterministic figures \
                      cannot be compared; regenerate the baseline with the same settings"
@@ -242,7 +293,12 @@ fn ran_points(report: &Report) -> bool {
 /// A workload the base ran and the new report lacks makes the figures incomparable (as any
 /// other changed setting); workloads only the new report has are new, not a regression (so a
 /// baseline from before point workloads still gates the ray workloads it has).
-fn workloads_comparable(base: &[String], new: &[String], findings: &mut Vec<Finding>) -> bool {
+fn workloads_comparable(
+    base: &[String],
+    new: &[String],
+    opts: &CompareOptions,
+    findings: &mut Vec<Finding>,
+) -> bool {
     let dropped: Vec<&str> = base
         .iter()
         .filter(|w| !new.contains(w))
@@ -256,14 +312,17 @@ fn workloads_comparable(base: &[String], new: &[String], findings: &mut Vec<Find
     if !added.is_empty() {
         findings.push(Finding {
             severity: Severity::Note,
+            at: String::new(),
             what: format!("new workloads (no baseline): {}", added.join(",")),
         });
     }
-    if dropped.is_empty() {
+    // A subset runs fewer workloads on purpose; the ones it ran still compare.
+    if dropped.is_empty() || opts.subset {
         return true;
     }
     findings.push(Finding {
         severity: Severity::Regression,
+        at: String::new(),
         what: format!(
             "different run settings (workloads: base `{}`, new `{}`): deterministic figures \
              cannot be compared; regenerate the baseline with the same settings",
@@ -291,6 +350,7 @@ fn compare_build_stats(b: &ResultEntry, n: &ResultEntry, findings: &mut Vec<Find
         if x != y {
             findings.push(Finding {
                 severity: Severity::Regression,
+                at: format!("{} / {}", b.scene, b.structure),
                 what: format!(
                     "{} / {}: {what} changed from {} to {} (deterministic)",
                     b.scene,
@@ -313,19 +373,17 @@ fn compare_build_time(
     opts: &CompareOptions,
     findings: &mut Vec<Finding>,
 ) {
-    // Lower is better: new / base - 1 is the slowdown.
     if let (Some(x), Some(y)) = (b.build_ratio_to_reference, n.build_ratio_to_reference)
         && b.structure != reference_name(b)
         && x > 0.0
     {
-        timing_finding(
-            &format!("{} / {}: build time ratio", b.scene, b.structure),
-            x,
-            y,
-            y / x - 1.0,
-            opts,
-            findings,
+        let at = format!("{} / {}", b.scene, b.structure);
+        let change = Change::new(
+            (x, b.build_ratio_interval),
+            (y, n.build_ratio_interval),
+            false,
         );
+        timing_finding(&at, "build time ratio", &change, opts, findings);
     }
 }
 
@@ -349,12 +407,14 @@ fn compare_workload(
     if bad(n) > bad(b) {
         findings.push(Finding {
             severity: Severity::Regression,
+            at: label.to_string(),
             what: format!("{label}: mismatches rose from {} to {}", bad(b), bad(n)),
         });
     }
     if gate_counters && b.counters_total != n.counters_total {
         findings.push(Finding {
             severity: Severity::Regression,
+            at: label.to_string(),
             what: format!(
                 "{label}: counters changed (deterministic): {} -> {}",
                 counters_text(b),
@@ -362,18 +422,13 @@ fn compare_workload(
             ),
         });
     }
-    // Higher is better: base / new - 1 is the slowdown.
     if let (Some(x), Some(y)) = (b.speedup_vs_reference, n.speedup_vs_reference)
         && !is_reference
+        && y > 0.0
     {
-        timing_finding(
-            &format!("{label}: {} ratio", throughput_unit(&b.workload)),
-            x,
-            y,
-            x / y - 1.0,
-            opts,
-            findings,
-        );
+        let change = Change::new((x, b.speedup_interval), (y, n.speedup_interval), true);
+        let what = format!("{} ratio", throughput_unit(&b.workload));
+        timing_finding(label, &what, &change, opts, findings);
     }
 }
 
@@ -393,26 +448,115 @@ fn counters_text(w: &WorkloadResult) -> String {
     }
 }
 
+/// A timing ratio's change between the reports, written one way everywhere: as a slowdown,
+/// the relative rise in time per query (or per build) against the reference, positive when the
+/// new report is slower.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Change {
+    pub base: f64,
+    pub new: f64,
+    pub slowdown: f64,
+    /// The slowdown's range when both ratios have confidence intervals: from the most
+    /// favourable ends to the least.
+    pub range: Option<(f64, f64)>,
+}
+
+impl Change {
+    /// `higher_is_better`: a throughput ratio (else a build time ratio).
+    pub fn new(
+        (base, base_interval): (f64, Option<Interval>),
+        (new, new_interval): (f64, Option<Interval>),
+        higher_is_better: bool,
+    ) -> Change {
+        let slow = |b: f64, n: f64| {
+            if higher_is_better {
+                b / n - 1.0
+            } else {
+                n / b - 1.0
+            }
+        };
+        let range = base_interval.zip(new_interval).map(|(bi, ni)| {
+            if higher_is_better {
+                (slow(bi.lo, ni.hi), slow(bi.hi, ni.lo))
+            } else {
+                (slow(bi.hi, ni.lo), slow(bi.lo, ni.hi))
+            }
+        });
+        Change {
+            base,
+            new,
+            slowdown: slow(base, new),
+            range,
+        }
+    }
+
+    /// Whether this is a slowdown beyond `threshold` that the intervals cannot explain away
+    /// (with no intervals, the point value decides).
+    pub fn significant_slowdown(&self, threshold: f64) -> bool {
+        self.slowdown > threshold && self.range.is_none_or(|(lo, _)| lo > threshold)
+    }
+
+    /// "12.5 % slower", "3.0 % faster" or "same".
+    pub fn words(&self) -> String {
+        words(self.slowdown)
+    }
+}
+
+fn words(slowdown: f64) -> String {
+    if slowdown.abs() < 0.0005 {
+        "same".into()
+    } else if slowdown > 0.0 {
+        format!("{:.1} % slower", slowdown * 100.0)
+    } else {
+        format!("{:.1} % faster", -slowdown * 100.0)
+    }
+}
+
 fn timing_finding(
-    label: &str,
-    base: f64,
-    new: f64,
-    slowdown: f64,
+    at: &str,
+    what: &str,
+    change: &Change,
     opts: &CompareOptions,
     findings: &mut Vec<Finding>,
 ) {
-    if slowdown > opts.max_slowdown {
-        findings.push(Finding {
-            severity: if opts.timing_advisory {
-                Severity::Advisory
-            } else {
-                Severity::Regression
-            },
-            what: format!(
-                "{label} {base:.3} -> {new:.3}: {:.1} % slower (threshold {:.0} %)",
-                slowdown * 100.0,
-                opts.max_slowdown * 100.0
+    if change.slowdown <= opts.max_slowdown {
+        return;
+    }
+    let (b, n) = (change.base, change.new);
+    let threshold = format!("threshold {:.0} %", opts.max_slowdown * 100.0);
+    let (severity, why) = match change.range {
+        Some((lo, hi)) if lo <= opts.max_slowdown => (
+            Severity::Advisory,
+            format!(
+                "not significant: the interval of the change, {} to {}, reaches the {threshold}",
+                words(lo),
+                words(hi)
             ),
-        });
+        ),
+        Some((lo, hi)) => (
+            regression_or_advisory(opts),
+            format!(
+                "significant: the interval of the change, {} to {}, is beyond the {threshold}",
+                words(lo),
+                words(hi)
+            ),
+        ),
+        None => (
+            regression_or_advisory(opts),
+            format!("{threshold}; no confidence intervals in these reports: a point test"),
+        ),
+    };
+    findings.push(Finding {
+        severity,
+        at: at.to_string(),
+        what: format!("{at}: {what} {b:.3} -> {n:.3}: {} ({why})", change.words()),
+    });
+}
+
+fn regression_or_advisory(opts: &CompareOptions) -> Severity {
+    if opts.timing_advisory {
+        Severity::Advisory
+    } else {
+        Severity::Regression
     }
 }
