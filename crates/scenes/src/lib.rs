@@ -20,6 +20,7 @@ pub mod points;
 mod recipe;
 mod request;
 mod rng;
+pub mod sha256;
 mod suite;
 mod view;
 mod workload;
@@ -108,6 +109,9 @@ pub enum SceneSource {
     },
     Obj {
         path: PathBuf,
+        /// SHA-256 of the file's bytes (as `sha256sum` prints it); empty in older reports.
+        #[serde(default)]
+        sha256: String,
     },
 }
 

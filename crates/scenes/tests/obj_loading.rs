@@ -169,7 +169,14 @@ fn bad_coordinates_drop_only_their_triangles_and_are_counted() {
     );
     assert_eq!(scene.removed.degenerate_kept, 1);
     assert_eq!(scene.name, "mixed");
-    assert_eq!(scene.source, SceneSource::Obj { path: path.clone() });
+    let sha256 = raybench_scenes::sha256::sha256_hex(&std::fs::read(&path).unwrap());
+    assert_eq!(
+        scene.source,
+        SceneSource::Obj {
+            path: path.clone(),
+            sha256
+        }
+    );
 }
 
 /// The three corners of triangle `i`, for checking what the loader built.

@@ -184,7 +184,7 @@ pub fn preview(
         .sum::<usize>();
     Ok(PreviewSummary {
         scene: match &scene.source {
-            SceneSource::Obj { path } => path.display().to_string(),
+            SceneSource::Obj { path, .. } => path.display().to_string(),
             SceneSource::Procedural { .. } => name.to_owned(),
         },
         view: view_name,

@@ -68,6 +68,7 @@ pub fn load_obj_bytes(path: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
         name: scene_name(path),
         source: SceneSource::Obj {
             path: path.to_owned(),
+            sha256: crate::sha256::sha256_hex(bytes),
         },
         view,
         views: vec![crate::NamedView {
