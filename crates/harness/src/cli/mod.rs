@@ -5,6 +5,7 @@
 
 pub mod bounds;
 pub mod compare;
+pub mod history;
 pub mod list;
 pub mod replay;
 pub mod report;

@@ -4,6 +4,7 @@
 
 pub mod agreement;
 pub mod compare_table;
+pub mod history;
 pub mod png;
 pub mod preview;
 pub mod render;
