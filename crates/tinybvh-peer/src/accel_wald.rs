@@ -170,7 +170,7 @@ impl Accel for TinyBvh {
             return Memory::default();
         };
         Memory {
-            nodes: (w.bvh().nodes().len() * size_of::<tinybvh_rs::bvh::Node>()) as u64,
+            nodes: size_of_val(w.bvh().nodes()) as u64,
             indices: (w.bvh().indices().len() * 4) as u64,
             primitives: size_of_val(w.positions()) as u64,
         }

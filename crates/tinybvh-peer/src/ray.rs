@@ -33,7 +33,7 @@ const _: () = assert!(size_of::<CppRay>() == 128 && align_of::<CppRay>() == 64);
 
 /// tinybvh's reciprocal: ±1e30 (the sign of `x`, +0 counting as positive) for |x| <= 1e-12.
 fn safe_rcp(x: f32) -> f32 {
-    if x > 1e-12 || x < -1e-12 {
+    if !(-1e-12..=1e-12).contains(&x) {
         1.0 / x
     } else if x >= 0.0 {
         INFINITE
@@ -50,7 +50,8 @@ impl CppRay {
     #[inline]
     pub(crate) fn new(ray: &Ray, exclusive_t_max: bool) -> Option<CppRay> {
         let (o, d, t_min) = (ray.origin(), ray.dir(), ray.t_min());
-        if !(o.is_finite() && d.is_finite()) || !(ray.t_max() >= t_min) {
+        let empty = ray.t_max().partial_cmp(&t_min).is_none_or(|o| o.is_lt());
+        if !o.is_finite() || !d.is_finite() || empty {
             return None;
         }
         let start = if t_min > 0.0 { o + d * t_min } else { o };

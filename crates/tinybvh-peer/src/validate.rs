@@ -114,9 +114,10 @@ pub(crate) fn mbvh8(data: &mbvh::BVHData, wald_refs: usize) -> Result<(), String
             }
             continue;
         }
-        // Empty child slots hold 0 and may sit anywhere among the eight.
+        // Empty child slots hold 0 and may sit anywhere among the eight; a mesh whose binary
+        // BVH is one leaf gets a root with that single child.
         let children = node.child.iter().filter(|&&c| c != 0);
-        if children.clone().count() != node.child_count as usize || node.child_count < 2 {
+        if children.clone().count() != node.child_count as usize || node.child_count < 1 {
             return Err(format!("node {i}: children {:?}", node.child));
         }
         for &c in children {

@@ -37,7 +37,7 @@ impl OwnedWald {
     /// Builds over `positions` (non-empty, a multiple of three vertices: tinybvh aborts the
     /// process on an empty vertex slice).
     pub(crate) fn build(positions: Box<[[f32; 4]]>, mode: BuildMode) -> Result<Self, String> {
-        debug_assert!(!positions.is_empty() && positions.len() % 3 == 0);
+        debug_assert!(!positions.is_empty() && positions.len().is_multiple_of(3));
         // SAFETY: the slice lives in a heap allocation owned by `positions`, which is stored in
         // the returned `OwnedWald` next to the BVH and never moved out of its box, resized or
         // written; the BVH field is dropped before `positions` (declaration order), and the
