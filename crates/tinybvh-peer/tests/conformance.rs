@@ -106,3 +106,51 @@ fn same_answers_and_shape_whatever_the_thread_count() {
     #[cfg(target_feature = "avx2")]
     deterministic::<raybench_tinybvh_peer::TinyBvh8>(&Default::default());
 }
+
+/// A finding, not a wrapper bug: tinybvh's scalar Möller–Trumbore (the Wald layout's) rejects
+/// |det| < 1e-6 in absolute terms, so a unit ray misses a triangle with half-millimetre edges
+/// (det = 2.5e-7 here) that brute force and Embree hit; BVH8_CPU's test has no such threshold.
+/// On stanford-bunny.obj (edges around 1e-3) this makes thousands of `peer-tinybvh` mismatches.
+#[test]
+fn wald_layout_misses_triangles_whose_determinant_is_below_1e_6() {
+    use raybench_accel::BruteForce;
+    use raybench_geom::{Ray, Vec3};
+    let e = 5e-4;
+    let mesh = raybench_testkit::mesh(
+        vec![Vec3::ZERO, Vec3::new(e, 0.0, 0.0), Vec3::new(0.0, e, 0.0)],
+        vec![[0, 1, 2]],
+    );
+    let ray = Ray::new(
+        Vec3::new(e / 4.0, e / 4.0, 1.0),
+        Vec3::NEG_Z,
+        0.0,
+        f32::INFINITY,
+    );
+    let oracle = BruteForce::build(mesh.clone(), &Default::default()).unwrap();
+    assert!(oracle.intersect(&ray).is_some());
+    for build in [BuildMode::Binned, BuildMode::Spatial] {
+        let tiny = TinyBvh::build(mesh.clone(), &params(build)).unwrap();
+        assert_eq!(tiny.intersect(&ray), None, "{build:?}");
+        // The same triangle ten times larger (det 2.5e-5) is hit.
+        let big = raybench_testkit::mesh(
+            vec![
+                Vec3::ZERO,
+                Vec3::new(10.0 * e, 0.0, 0.0),
+                Vec3::new(0.0, 10.0 * e, 0.0),
+            ],
+            vec![[0, 1, 2]],
+        );
+        let tiny = TinyBvh::build(big, &params(build)).unwrap();
+        assert!(tiny.intersect(&ray).is_some(), "{build:?}");
+    }
+    #[cfg(target_feature = "avx2")]
+    {
+        let bvh8 = raybench_tinybvh_peer::TinyBvh8::build(mesh, &Default::default()).unwrap();
+        let (got, want) = (
+            bvh8.intersect(&ray).unwrap(),
+            oracle.intersect(&ray).unwrap(),
+        );
+        assert_eq!(got.prim, want.prim);
+        assert!((got.t - want.t).abs() <= 1e-6, "{got:?} {want:?}");
+    }
+}

@@ -40,7 +40,7 @@ pub fn entries() -> Vec<StructureEntry> {
         )),
         peer(register::<TinyBvh>(
             "peer-tinybvh",
-            "crate tinybvh-rs 0.1.0-beta.3 (MIT) over tinybvh 1.6.8 (C++, MIT; compiled with -march=native, params.cxx_march names the ISA): binary Wald BVH, BVH::Build (binned SAH, 8 bins), tinybvh's scalar traversal and Möller–Trumbore; any hit emulated with closest hit; t_min by moving the origin; closest point not offered; memory from the crate's node and index slices plus its vertex copy",
+            "crate tinybvh-rs 0.1.0-beta.3 (MIT) over tinybvh 1.6.8 (C++, MIT; compiled with -march=native, params.cxx_march names the ISA): binary Wald BVH, BVH::Build (binned SAH, 8 bins), tinybvh's scalar traversal and Möller–Trumbore (which misses any triangle with |det| < 1e-6: small triangles, see docs/structures.md); any hit emulated with closest hit; t_min by moving the origin; closest point not offered; memory from the crate's node and index slices plus its vertex copy",
             None,
             |_| TinyBvhParams::default(),
         )),
