@@ -40,9 +40,10 @@ impl OwnedWald {
         debug_assert!(!positions.is_empty() && positions.len().is_multiple_of(3));
         // SAFETY: the slice lives in a heap allocation owned by `positions`, which is stored in
         // the returned `OwnedWald` next to the BVH and never moved out of its box, resized or
-        // written; the BVH field is dropped before `positions` (declaration order), and the
-        // `'static` reference never leaves this struct (no accessor hands it or the BVH's
-        // lifetime out). Moving the `Box` itself does not move the heap slice.
+        // written; the BVH field is dropped before `positions` (declaration order). The
+        // `'static` slice itself never leaves this function, and `bvh()` lends the BVH only for
+        // as long as `self` is borrowed: tinybvh-rs offers no way to get the positions or an
+        // owned BVH back through `&BVH`. Moving the `Box` itself does not move the heap slice.
         let borrowed: &'static [[f32; 4]] =
             unsafe { &*std::ptr::from_ref::<[[f32; 4]]>(&positions) };
         let built = match mode {
