@@ -93,7 +93,17 @@ fn every_peer_is_registered_as_a_peer_and_only_peers_are() {
     let peers: Vec<&str> = all.iter().filter(|e| e.peer).map(|e| e.name).collect();
     assert_eq!(
         peers,
-        ["peer-bvh", "peer-obvhs", "peer-parry3d", "peer-kdtree-ray"]
+        [
+            "peer-bvh",
+            "peer-obvhs",
+            "peer-parry3d",
+            "peer-kdtree-ray",
+            "peer-tinybvh",
+            "peer-tinybvh-hq",
+        ]
+        .into_iter()
+        .chain(cfg!(target_feature = "avx2").then_some("peer-tinybvh-bvh8"))
+        .collect::<Vec<_>>()
     );
     assert!(all.iter().all(|e| e.peer == e.name.starts_with("peer-")));
 }

@@ -25,6 +25,10 @@ pub fn run() -> Result<ExitCode> {
             println!("  {:<24} {}{limit}", e.name, e.description);
         }
     }
+    #[cfg(feature = "peers")]
+    for (name, why) in crate::peers::unavailable() {
+        println!("  {name:<24} unavailable in this build: {why}");
+    }
     let mut out = std::io::stdout().lock();
     writeln!(out)?;
     write_generators(&mut out, false)?;

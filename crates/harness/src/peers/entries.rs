@@ -5,6 +5,7 @@ use super::{
     BvhCrate, BvhCrateParams, KdtreeRay, KdtreeRayParams, Obvhs, ObvhsParams, Parry, ParryParams,
 };
 use crate::registry::{StructureEntry, register};
+use raybench_tinybvh_peer::{BuildMode, TinyBvh, TinyBvhParams};
 
 fn peer(mut e: StructureEntry) -> StructureEntry {
     e.peer = true;
@@ -37,5 +38,39 @@ pub fn entries() -> Vec<StructureEntry> {
             None,
             |_| KdtreeRayParams {},
         )),
+        peer(register::<TinyBvh>(
+            "peer-tinybvh",
+            "crate tinybvh-rs 0.1.0-beta.3 (MIT) over tinybvh 1.6.8 (C++, MIT; compiled with -march=native, params.cxx_march names the ISA): binary Wald BVH, BVH::Build (binned SAH, 8 bins), tinybvh's scalar traversal and Möller–Trumbore (which misses any triangle with |det| < 1e-6: small triangles, see docs/structures.md); any hit emulated with closest hit; t_min by moving the origin; closest point not offered; memory from the crate's node and index slices plus its vertex copy",
+            None,
+            |_| TinyBvhParams::default(),
+        )),
+        peer(register::<TinyBvh>(
+            "peer-tinybvh-hq",
+            "as peer-tinybvh, built with BVH::BuildHQ (SBVH: binned SAH with spatial splits)",
+            None,
+            |_| TinyBvhParams {
+                build: BuildMode::Spatial,
+                ..TinyBvhParams::default()
+            },
+        )),
+        #[cfg(target_feature = "avx2")]
+        peer(register::<raybench_tinybvh_peer::TinyBvh8>(
+            "peer-tinybvh-bvh8",
+            "as peer-tinybvh, leaves split to 4 triangles and converted through MBVH8 to BVH8_CPU (8-wide 256-byte nodes, 4-triangle leaves tested 4-wide with an approximate reciprocal); any hit emulated with closest hit; memory estimated from the MBVH8's node and leaf counts times BVH8_CPU's node and leaf sizes",
+            None,
+            |_| Default::default(),
+        )),
     ]
+}
+
+/// Peers this build cannot offer, with the reason (`raybench list` shows them).
+pub fn unavailable() -> Vec<(&'static str, &'static str)> {
+    let mut out = Vec::new();
+    if !raybench_tinybvh_peer::BVH8_AVAILABLE {
+        out.push((
+            "peer-tinybvh-bvh8",
+            raybench_tinybvh_peer::BVH8_UNAVAILABLE_REASON,
+        ));
+    }
+    out
 }

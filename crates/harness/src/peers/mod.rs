@@ -1,4 +1,5 @@
-//! Peers: the Rust crates a user would otherwise pick (`bvh`, `obvhs`, `parry3d`, `kdtree-ray`),
+//! Peers: the Rust crates a user would otherwise pick (`bvh`, `obvhs`, `parry3d`, `kdtree-ray`,
+//! `tinybvh-rs` through the `raybench-tinybvh-peer` crate, which holds its `unsafe`),
 //! wrapped as `peer-*` entries so they are built from the same mesh, traced with the same rays
 //! and checked with the same validation classes as raybench's own structures. Each wrapper goes
 //! through the crate's public API only; where a crate hands back candidate primitives rather
@@ -15,7 +16,7 @@ mod obvhs;
 mod parry;
 
 pub use bvh_crate::{BvhCrate, BvhCrateParams};
-pub use entries::entries;
+pub use entries::{entries, unavailable};
 pub use kdtree_ray::{KdtreeRay, KdtreeRayParams};
 pub use obvhs::{Obvhs, ObvhsParams};
 pub use parry::{Parry, ParryParams};
