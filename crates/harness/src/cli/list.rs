@@ -1,17 +1,21 @@
 //! `raybench list`: the structures, scene generators, real scenes, workloads and suites.
 
 use super::scene::{write_generators, write_real_scenes};
-use crate::registry;
+use crate::registry::Registry;
 use anyhow::Result;
 use raybench_scenes::Workload;
 use std::io::Write;
 use std::process::ExitCode;
 
-pub fn run() -> Result<ExitCode> {
-    let (peers, own): (Vec<_>, Vec<_>) = registry::registry().into_iter().partition(|e| e.peer);
+pub fn run(registry: &Registry) -> Result<ExitCode> {
+    let all = registry.entries();
+    let own = all.iter().filter(|e| !e.peer && !e.registered).collect();
+    let peers = all.iter().filter(|e| e.peer).collect();
+    let registered: Vec<_> = all.iter().filter(|e| e.registered).collect();
     for (heading, entries) in [
         ("Structures:", own),
         ("\nPeers (other crates' structures):", peers),
+        ("\nRegistered by this program:", registered),
     ] {
         if entries.is_empty() {
             continue;
