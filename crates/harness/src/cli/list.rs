@@ -8,28 +8,8 @@ use std::io::Write;
 use std::process::ExitCode;
 
 pub fn run(registry: &Registry) -> Result<ExitCode> {
-    let all = registry.entries();
-    let own = all.iter().filter(|e| !e.peer && !e.registered).collect();
-    let peers = all.iter().filter(|e| e.peer).collect();
-    let registered: Vec<_> = all.iter().filter(|e| e.registered).collect();
-    for (heading, entries) in [
-        ("Structures:", own),
-        ("\nPeers (other crates' structures):", peers),
-        ("\nRegistered by this program:", registered),
-    ] {
-        if entries.is_empty() {
-            continue;
-        }
-        println!("{heading}");
-        for e in entries {
-            let limit = e
-                .suite_triangle_limit
-                .map(|l| format!(" (suites: up to {l} triangles)"))
-                .unwrap_or_default();
-            println!("  {:<24} {}{limit}", e.name, e.description);
-        }
-    }
     let mut out = std::io::stdout().lock();
+    write_structures(registry, &mut out)?;
     writeln!(out)?;
     write_generators(&mut out, false)?;
     writeln!(out)?;
@@ -57,4 +37,31 @@ pub fn run(registry: &Registry) -> Result<ExitCode> {
         );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The structures of `registry` under three headings: raybench's own, the peers (other crates'
+/// structures) and those the running program registered; an empty group has no heading.
+pub fn write_structures(registry: &Registry, out: &mut impl Write) -> std::io::Result<()> {
+    let all = registry.entries();
+    let own = all.iter().filter(|e| !e.peer && !e.registered).collect();
+    let peers = all.iter().filter(|e| e.peer).collect();
+    let registered: Vec<_> = all.iter().filter(|e| e.registered).collect();
+    for (heading, entries) in [
+        ("Structures:", own),
+        ("\nPeers (other crates' structures):", peers),
+        ("\nRegistered by this program:", registered),
+    ] {
+        if entries.is_empty() {
+            continue;
+        }
+        writeln!(out, "{heading}")?;
+        for e in entries {
+            let limit = e
+                .suite_triangle_limit
+                .map(|l| format!(" (suites: up to {l} triangles)"))
+                .unwrap_or_default();
+            writeln!(out, "  {:<24} {}{limit}", e.name, e.description)?;
+        }
+    }
+    Ok(())
 }
