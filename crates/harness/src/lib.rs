@@ -18,3 +18,5 @@ pub mod peers;
 pub mod pipeline;
 pub mod registry;
 pub mod report;
+
+pub use registry::Registry;

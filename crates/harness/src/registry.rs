@@ -1,5 +1,10 @@
 //! The name → structure registry. Adding a structure to raybench means one `register` line here
-//! (see README, "Adding a structure").
+//! (see README, "Adding a structure"); a program that depends on raybench-harness adds its own
+//! to a [`Registry`] instead (see README, "Benchmark your own structure").
+
+mod program;
+
+pub use program::{RegisterError, Registry};
 
 use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
 use raybench_bvh::{
@@ -38,6 +43,7 @@ impl std::fmt::Debug for Built {
 
 type Builder = dyn Fn(Arc<TriangleMesh>, &BuildContext) -> Result<Built, BuildError> + Send + Sync;
 
+#[derive(Clone)]
 pub struct StructureEntry {
     pub name: &'static str,
     pub description: &'static str,
@@ -47,7 +53,10 @@ pub struct StructureEntry {
     /// Another crate's structure wrapped for comparison (`peer-*`), not one of raybench's own:
     /// `raybench list` shows these under their own heading.
     pub peer: bool,
-    builder: Box<Builder>,
+    /// Added by the program running raybench ([`Registry::register`]), not built in: `raybench
+    /// list` shows these under their own heading.
+    pub registered: bool,
+    builder: Arc<Builder>,
 }
 
 impl std::fmt::Debug for StructureEntry {
@@ -89,7 +98,8 @@ pub(crate) fn register<A: Accel + 'static>(
         description,
         suite_triangle_limit,
         peer: false,
-        builder: Box::new(builder),
+        registered: false,
+        builder: Arc::new(builder),
     }
 }
 
@@ -103,7 +113,8 @@ fn embree(base: EmbreeParams) -> impl Fn(&BuildContext) -> EmbreeParams + Send +
 /// Brute force tests every triangle: 20k triangles × 100k rays is already 2e9 tests per pass.
 const BRUTE_FORCE_SUITE_LIMIT: usize = 20_000;
 
-/// Every structure raybench knows, in the order reports list them.
+/// Every structure raybench itself knows, in the order reports list them: what
+/// [`Registry::builtin`] starts from.
 pub fn registry() -> Vec<StructureEntry> {
     #[cfg_attr(not(feature = "peers"), allow(unused_mut))]
     let mut all = own_structures();
@@ -325,21 +336,4 @@ fn own_structures() -> Vec<StructureEntry> {
             embree(EmbreeParams::robust()),
         ),
     ]
-}
-
-/// Looks up names, keeping the registry order; unknown names are an error listing the known.
-pub fn select(names: &[String]) -> anyhow::Result<Vec<StructureEntry>> {
-    let all = registry();
-    let known: Vec<&str> = all.iter().map(|e| e.name).collect();
-    if let Some(bad) = names.iter().find(|n| !known.contains(&n.as_str())) {
-        anyhow::bail!("unknown structure '{bad}'; known: {}", known.join(", "));
-    }
-    Ok(all
-        .into_iter()
-        .filter(|e| names.iter().any(|n| n == e.name))
-        .collect())
-}
-
-pub fn find(name: &str) -> anyhow::Result<StructureEntry> {
-    Ok(select(&[name.to_string()])?.remove(0))
 }

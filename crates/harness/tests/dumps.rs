@@ -4,9 +4,10 @@
 
 mod common;
 
+use raybench_harness::Registry;
 use raybench_harness::pipeline::dump::{read_dump, read_index};
 use raybench_harness::pipeline::run::{RunOptions, run};
-use raybench_harness::registry::{self, BuildContext};
+use raybench_harness::registry::BuildContext;
 use raybench_harness::report::run::Report;
 use raybench_scenes::SceneRequest;
 use std::collections::BTreeMap;
@@ -75,7 +76,8 @@ fn a_dump_matches_the_report_and_a_re_trace() {
             .entry(e.workload.clone())
             .or_insert_with(|| bits.clone());
         assert_eq!(*first, bits, "{}", e.file);
-        let accel = registry::find(&e.structure)
+        let accel = Registry::builtin()
+            .find(&e.structure)
             .unwrap()
             .build(mesh.clone(), &BuildContext { threads: 1 })
             .unwrap()
@@ -134,7 +136,7 @@ fn hits_and_counters_are_identical_across_repeats_and_thread_counts() {
         "soup:triangles=300",
         "coplanar:triangles=200",
     ];
-    let all: Vec<String> = raybench_harness::cli::all_structures();
+    let all: Vec<String> = Registry::builtin().names();
     let names: Vec<&str> = all.iter().map(String::as_str).collect();
     let one = RunOptions {
         rays: 300,

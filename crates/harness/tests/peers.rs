@@ -89,7 +89,8 @@ fn kdtree_ray_fails_only_its_known_cases() {
 
 #[test]
 fn every_peer_is_registered_as_a_peer_and_only_peers_are() {
-    let all = registry::registry();
+    let registry = registry::Registry::builtin();
+    let all = registry.entries();
     let peers: Vec<&str> = all.iter().filter(|e| e.peer).map(|e| e.name).collect();
     assert_eq!(
         peers,

@@ -2,10 +2,11 @@
 
 mod common;
 
+use raybench_harness::Registry;
 use raybench_harness::pipeline::check::check_points;
 use raybench_harness::pipeline::measure::point_pass;
 use raybench_harness::pipeline::run::{RunOptions, run};
-use raybench_harness::registry::{self, BuildContext};
+use raybench_harness::registry::BuildContext;
 use raybench_harness::report::compare::{CompareOptions, Severity, compare};
 use raybench_harness::report::run::{Report, WorkloadResult};
 use raybench_scenes::SceneRequest;
@@ -125,7 +126,8 @@ fn batch_answers_are_identical_on_one_and_two_threads_and_a_wrong_answer_is_a_mi
         "seeded"
     );
     let ctx = BuildContext { threads: 2 };
-    let grid = registry::find("grid")
+    let grid = Registry::builtin()
+        .find("grid")
         .unwrap()
         .build(mesh.clone(), &ctx)
         .unwrap()
@@ -142,7 +144,8 @@ fn batch_answers_are_identical_on_one_and_two_threads_and_a_wrong_answer_is_a_mi
     let single = pass(1);
     assert_eq!(single, pass(2));
     assert!(single.iter().all(Option::is_some));
-    let embree = registry::find("embree-medium")
+    let embree = Registry::builtin()
+        .find("embree-medium")
         .unwrap()
         .build(mesh.clone(), &ctx)
         .unwrap()

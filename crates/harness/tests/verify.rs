@@ -45,7 +45,7 @@ fn requests() -> Vec<SceneRequest> {
 fn report() -> &'static VerifyReport {
     static REPORT: OnceLock<VerifyReport> = OnceLock::new();
     REPORT.get_or_init(|| {
-        let all = raybench_harness::cli::all_structures();
+        let all = raybench_harness::Registry::builtin().names();
         verify(&options(all, None), &requests()).unwrap()
     })
 }
@@ -55,7 +55,7 @@ fn every_structure_is_checked_against_three_references_with_zero_mismatches() {
     let r = report();
     assert!(r.errors.is_empty(), "{:?}", r.errors);
     assert_eq!(r.mismatches(), 0, "{}", verify_table(r));
-    let n = raybench_harness::cli::all_structures().len();
+    let n = raybench_harness::Registry::builtin().names().len();
     assert_eq!(r.settings.structures.len(), n);
     let mut subsampled = 0;
     for scene in &r.scenes {

@@ -5,6 +5,7 @@
 
 pub mod bounds;
 pub mod compare;
+mod entry;
 pub mod history;
 pub mod list;
 pub mod replay;
@@ -15,9 +16,11 @@ pub mod scene;
 pub mod verify;
 pub mod watertight;
 
+pub use entry::main_with;
+
 use crate::outdir::{self, OutDir, Output};
 use crate::pipeline::scenes::check_requests;
-use crate::registry;
+use crate::registry::Registry;
 use anyhow::{Context, Result};
 use clap::Args;
 use raybench_scenes::{SceneRequest, Workload};
@@ -99,8 +102,14 @@ pub struct Defaults {
 impl Selection {
     /// Reads the suite, then checks scene specs, OBJ paths and structure names, so that a bad
     /// value fails before anything runs or is written. `defaults.structures` applies when
-    /// neither the flags nor (if `suite_structures`) the suite name any.
-    pub fn resolve(&self, suite_structures: bool, defaults: Defaults) -> Result<Resolved> {
+    /// neither the flags nor (if `suite_structures`) the suite name any; structure names are
+    /// looked up in `registry`.
+    pub fn resolve(
+        &self,
+        registry: &Registry,
+        suite_structures: bool,
+        defaults: Defaults,
+    ) -> Result<Resolved> {
         let (suite, requests) = match &self.suite {
             Some(name) => {
                 let path = raybench_scenes::suites_dir().join(format!("{name}.json"));
@@ -128,7 +137,7 @@ impl Selection {
             from_suite.map(|s| s.structures.clone()),
             || defaults.structures,
         );
-        registry::select(&structures)?;
+        registry.select(&structures)?;
         let workloads = pick(
             self.workloads.clone(),
             suite.as_ref().map(|s| s.workloads.clone()),
@@ -178,14 +187,6 @@ pub(crate) fn no_duplicates(flag: &str, names: impl Iterator<Item = String>) -> 
         );
     }
     Ok(())
-}
-
-/// Every registered structure's name.
-pub fn all_structures() -> Vec<String> {
-    registry::registry()
-        .iter()
-        .map(|e| e.name.to_string())
-        .collect()
 }
 
 pub fn specs(scenes: &[String]) -> Vec<SceneRequest> {

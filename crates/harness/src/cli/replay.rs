@@ -2,8 +2,8 @@
 //! and a double-precision test over every triangle.
 
 use crate::output::replay_text::replay_text;
-use crate::pipeline::replay::{parse_ray_bits, replay};
-use crate::registry;
+use crate::pipeline::replay::{parse_ray_bits, replay_with};
+use crate::registry::Registry;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::process::ExitCode;
@@ -27,14 +27,14 @@ pub struct ReplayArgs {
 }
 
 /// `raybench replay`: one ray through every structure, the references and an f64 test.
-pub fn run(args: ReplayArgs) -> Result<ExitCode> {
+pub fn run(registry: &Registry, args: ReplayArgs) -> Result<ExitCode> {
     let ray = parse_ray_bits(&args.ray.join(","))?;
-    registry::select(&args.structure)?;
+    registry.select(&args.structure)?;
     if !args.scene.to_ascii_lowercase().ends_with(".obj") {
         raybench_scenes::check_spec(&args.scene)
             .with_context(|| format!("scene '{}'", args.scene))?;
     }
-    let replay = replay(&args.scene, &args.structure, ray, args.seed)?;
+    let replay = replay_with(registry, &args.scene, &args.structure, ray, args.seed)?;
     print!("{}", replay_text(&replay));
     Ok(ExitCode::SUCCESS)
 }

@@ -1,13 +1,13 @@
 //! `raybench run`: build, time, count and check every structure; write report.json and draw it.
 
 use super::report::print_rendered;
-use super::{DEFAULT_POINTS, Defaults, Selection, all_structures, claim_outputs, exit_status};
+use super::{DEFAULT_POINTS, Defaults, Selection, claim_outputs, exit_status};
 use crate::outdir;
 use crate::output::render::render;
 use crate::output::summary::summary_table;
 use crate::pipeline::picture;
-use crate::pipeline::run::{RunOptions, run as run_pipeline};
-use crate::registry;
+use crate::pipeline::run::{RunOptions, run_with};
+use crate::registry::Registry;
 use anyhow::Result;
 use clap::Args;
 use std::io::IsTerminal;
@@ -48,17 +48,17 @@ pub struct RunArgs {
     dump_hits: Option<PathBuf>,
 }
 
-pub fn run(args: RunArgs) -> Result<ExitCode> {
+pub fn run(registry: &Registry, args: RunArgs) -> Result<ExitCode> {
     let defaults = Defaults {
-        structures: all_structures(),
+        structures: registry.names(),
         rays: 100_000,
         points: DEFAULT_POINTS,
     };
-    let r = args.selection.resolve(true, defaults)?;
+    let r = args.selection.resolve(registry, true, defaults)?;
     if !args.no_images {
         check_picture_memory(args.picture_width, r.structures.len())?;
     }
-    registry::find(&args.reference)?;
+    registry.find(&args.reference)?;
     let claimed = claim_outputs(
         args.out.as_deref(),
         outdir::RUN,
@@ -86,7 +86,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         picture_dir: Some(dir.to_path_buf()),
         picture_width: args.picture_width,
     };
-    let report = run_pipeline(&opts, &r.requests)?;
+    let report = run_with(registry, &opts, &r.requests)?;
     let path = report.write_atomic(dir)?;
     print!("{}", summary_table(&report));
     println!(

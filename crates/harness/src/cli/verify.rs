@@ -1,11 +1,10 @@
 //! `raybench verify`: check answers, not speed, against three references; write verify.json.
 
-use super::{
-    DEFAULT_POINTS, Defaults, Selection, all_structures, budget, claim_outputs, exit_status,
-};
+use super::{DEFAULT_POINTS, Defaults, Selection, budget, claim_outputs, exit_status};
 use crate::outdir;
 use crate::output::verify_table::verify_table;
-use crate::pipeline::verify::{BRUTE_FORCE_BUDGET, VerifyOptions, verify};
+use crate::pipeline::verify::{BRUTE_FORCE_BUDGET, VerifyOptions, verify_with};
+use crate::registry::Registry;
 use anyhow::Result;
 use clap::Args;
 use std::io::IsTerminal;
@@ -33,15 +32,15 @@ pub struct VerifyArgs {
 
 /// `raybench verify`: exit 0 with no mismatch, 2 on any mismatch (or counted-path
 /// difference), 1 on errors.
-pub fn run(args: VerifyArgs) -> Result<ExitCode> {
+pub fn run(registry: &Registry, args: VerifyArgs) -> Result<ExitCode> {
     // Verify checks every registered structure unless told otherwise: a suite's structure list
     // says what is worth timing, not what may go unchecked.
     let defaults = Defaults {
-        structures: all_structures(),
+        structures: registry.names(),
         rays: 10_000,
         points: DEFAULT_POINTS,
     };
-    let r = args.selection.resolve(false, defaults)?;
+    let r = args.selection.resolve(registry, false, defaults)?;
     let claimed = claim_outputs(
         args.out.as_deref(),
         outdir::VERIFY,
@@ -62,7 +61,7 @@ pub fn run(args: VerifyArgs) -> Result<ExitCode> {
         brute_force_budget: args.brute_force_budget,
         dump_hits: args.dump_hits.clone(),
     };
-    let report = verify(&opts, &r.requests)?;
+    let report = verify_with(registry, &opts, &r.requests)?;
     let path = report.write_atomic(dir)?;
     print!("{}", verify_table(&report));
     println!(

@@ -1,10 +1,10 @@
 //! `raybench watertight`: crack hunting; write watertight.json and print the miss rates.
 
-use super::{all_structures, at_least_one, budget, exit_status, pick};
+use super::{at_least_one, budget, exit_status, pick};
 use crate::output::watertight_table::watertight_table;
 use crate::pipeline::verify::BRUTE_FORCE_BUDGET;
-use crate::pipeline::watertight::{WatertightOptions, default_cases, watertight};
-use crate::registry;
+use crate::pipeline::watertight::{WatertightOptions, default_cases, watertight_with};
+use crate::registry::Registry;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -35,9 +35,9 @@ pub struct WatertightArgs {
 }
 
 /// `raybench watertight`: exit 0, or 1 on errors (a crack is a figure, not a failure).
-pub fn run(args: WatertightArgs) -> Result<ExitCode> {
-    let structures = pick(args.structures, None, all_structures);
-    registry::select(&structures)?;
+pub fn run(registry: &Registry, args: WatertightArgs) -> Result<ExitCode> {
+    let structures = pick(args.structures, None, || registry.names());
+    registry.select(&structures)?;
     super::no_duplicates("--structures", structures.iter().cloned())?;
     super::bounds::check_rays(args.rays, 1, false)?;
     let claimed = super::claim_outputs(
@@ -55,7 +55,7 @@ pub fn run(args: WatertightArgs) -> Result<ExitCode> {
         threads: args.threads,
         brute_force_budget: args.brute_force_budget,
     };
-    let report = watertight(&opts)?;
+    let report = watertight_with(registry, &opts)?;
     let path = report.write_atomic(dir)?;
     print!("{}", watertight_table(&report));
     println!(

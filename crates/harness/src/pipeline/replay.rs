@@ -3,7 +3,7 @@
 //! against `embree-medium`. The ray comes from a report's `ray_bits` or verify's replay line.
 
 use super::check::verdict_name;
-use crate::registry::{self, BuildContext};
+use crate::registry::{BuildContext, Registry};
 use anyhow::{Context, Result, bail};
 use raybench_accel::classify::{Tolerance, classify, classify_occlusion};
 use raybench_accel::{Accel, Hit};
@@ -157,14 +157,22 @@ pub struct Replay {
     pub answers: Vec<StructureAnswer>,
 }
 
-/// Loads the scene, builds the requested structures (default: every registered one) plus the
-/// references, and traces the one ray through each.
+/// [`replay_with`] the built-in structures.
 pub fn replay(scene_spec: &str, structures: &[String], ray: Ray, seed: u64) -> Result<Replay> {
+    replay_with(&Registry::builtin(), scene_spec, structures, ray, seed)
+}
+
+/// Loads the scene, builds the requested structures (default: every one in `registry`) plus
+/// the references, and traces the one ray through each.
+pub fn replay_with(
+    registry: &Registry,
+    scene_spec: &str,
+    structures: &[String],
+    ray: Ray,
+    seed: u64,
+) -> Result<Replay> {
     let mut names: Vec<String> = if structures.is_empty() {
-        registry::registry()
-            .iter()
-            .map(|e| e.name.to_string())
-            .collect()
+        registry.names()
     } else {
         structures.to_vec()
     };
@@ -173,7 +181,7 @@ pub fn replay(scene_spec: &str, structures: &[String], ray: Ray, seed: u64) -> R
             names.insert(0, r.to_string());
         }
     }
-    let entries = registry::select(&names)?;
+    let entries = registry.select(&names)?;
     let scene = raybench_scenes::resolve(scene_spec, seed)
         .with_context(|| format!("scene '{scene_spec}'"))?;
     let mesh = scene.mesh.clone();

@@ -16,7 +16,7 @@ use super::rounds::{self, Job, Pending};
 use super::scenes::for_each_scene;
 use super::workers::{Log, Progress, Workers, catch_panic};
 use super::workloads::{PreparedPoints, QueryCounts, SceneRun, prepare_workload, triangle_counts};
-use crate::registry::{self, BuildContext, StructureEntry};
+use crate::registry::{BuildContext, Registry, StructureEntry};
 use crate::report::Header;
 use crate::report::interval::{Interval, median_with_interval, paired_ratios};
 use crate::report::run::*;
@@ -69,9 +69,15 @@ impl RunOptions {
     }
 }
 
-/// Runs everything and returns the report (not yet written). With `dump_hits`, every
-/// structure's answers are written there as they are measured (see [`super::dump`]).
+/// [`run_with`] the built-in structures.
 pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
+    run_with(&Registry::builtin(), opts, scenes)
+}
+
+/// Runs everything, looking structure names up in `registry`, and returns the report (not yet
+/// written). With `dump_hits`, every structure's answers are written there as they are
+/// measured (see [`super::dump`]).
+pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
     anyhow::ensure!(opts.rays >= 1, "--rays must be at least 1 (got 0)");
     anyhow::ensure!(opts.points >= 1, "--points must be at least 1 (got 0)");
     anyhow::ensure!(
@@ -81,15 +87,15 @@ pub fn run(opts: &RunOptions, scenes: &[SceneRequest]) -> Result<Report> {
         picture::MAX_WIDTH,
         opts.picture_width
     );
-    let mut structures = registry::select(&opts.structures)?;
-    let reference_entry = registry::find(&opts.reference)?;
+    let mut structures = registry.select(&opts.structures)?;
+    let reference_entry = registry.find(&opts.reference)?;
     let mut log = Log::default();
     if !structures.iter().any(|e| e.name == reference_entry.name) {
         log.notes.push(format!(
             "reference {} added to the measured structures so ratios can be computed",
             opts.reference
         ));
-        structures.insert(0, registry::find(&opts.reference)?);
+        structures.insert(0, reference_entry.clone());
     }
     let mut dump = opts.dump_hits.as_deref().map(DumpDir::create).transpose()?;
     log.notes

@@ -26,7 +26,7 @@ use super::scenes::{LoadedScene, for_each_scene};
 use super::workers::{Log, Progress, Workers, catch_panic};
 use crate::env::Environment;
 use crate::output::agreement::agreement_sentence;
-use crate::registry::{self, StructureEntry};
+use crate::registry::{Registry, StructureEntry};
 use crate::report::Header;
 use crate::report::agreement::Agreement;
 use crate::report::verify::{
@@ -85,14 +85,29 @@ pub fn brute_force_sample(rays: usize, triangles: usize, budget: u64) -> Vec<usi
         .collect()
 }
 
-/// Checks every structure on every scene; the report is not yet written.
+/// [`verify_with`] the built-in structures.
 pub fn verify(opts: &VerifyOptions, requests: &[SceneRequest]) -> Result<VerifyReport> {
+    verify_with(&Registry::builtin(), opts, requests)
+}
+
+/// Checks every structure on every scene, looking names (the subjects' and the references')
+/// up in `registry`; the report is not yet written.
+pub fn verify_with(
+    registry: &Registry,
+    opts: &VerifyOptions,
+    requests: &[SceneRequest],
+) -> Result<VerifyReport> {
     ensure!(opts.rays >= 1, "--rays must be at least 1 (got 0)");
     ensure!(
         opts.brute_force_budget >= 1,
         "the brute-force budget must be at least 1"
     );
-    let subjects = registry::select(&opts.structures)?;
+    let subjects = registry.select(&opts.structures)?;
+    let references = [
+        registry.find(REFERENCES[0])?,
+        registry.find(REFERENCES[1])?,
+        registry.find(REFERENCES[2])?,
+    ];
     let mut dump = opts.dump_hits.as_deref().map(DumpDir::create).transpose()?;
     let workers = Workers::start(opts.threads, opts.ftz_daz)?;
     let progress = Progress::new(
@@ -101,6 +116,7 @@ pub fn verify(opts: &VerifyOptions, requests: &[SceneRequest]) -> Result<VerifyR
     );
     let checker = Checker {
         opts,
+        references: &references,
         tol: Tolerance::default(),
         progress: &progress,
     };
@@ -183,10 +199,11 @@ fn verify_scene(
     checker
         .progress
         .step(format!("{name}: workloads and reference answers"));
-    let refs = match catch_panic(|| SceneReferences::prepare(checker.opts, scene)) {
-        Ok(r) => r,
-        Err(e) => return log.errors.push(format!("scene {name}: {e:#}")),
-    };
+    let refs =
+        match catch_panic(|| SceneReferences::prepare(checker.opts, checker.references, scene)) {
+            Ok(r) => r,
+            Err(e) => return log.errors.push(format!("scene {name}: {e:#}")),
+        };
     report.scenes.push(VerifiedScene {
         name: name.clone(),
         spec: request.label(),

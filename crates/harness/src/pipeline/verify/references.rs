@@ -2,11 +2,11 @@
 //! answers (as `run` makes them), `embree-robust` on every query, and `bruteforce` on its
 //! budgeted subsample.
 
-use super::{REFERENCES, VerifyOptions, brute_force_sample};
+use super::{VerifyOptions, brute_force_sample};
 use crate::pipeline::measure::{Answers, point_pass};
 use crate::pipeline::scenes::LoadedScene;
 use crate::pipeline::workloads::{QueryCounts, SceneRun, reference_answers};
-use crate::registry::{self, BuildContext};
+use crate::registry::{BuildContext, StructureEntry};
 use anyhow::Result;
 use raybench_accel::{Accel, PointHit};
 use std::borrow::Cow;
@@ -40,26 +40,23 @@ pub(super) struct WorkloadReferences {
 }
 
 impl<'a> SceneReferences<'a> {
-    /// Builds the three references and answers every workload with each (brute force on its
-    /// budgeted subsample only).
+    /// Builds the three references (`entries`, the structures named by [`super::REFERENCES`]) and
+    /// answers every workload with each (brute force on its budgeted subsample only).
     pub(super) fn prepare(
         o: &VerifyOptions,
+        entries: &[StructureEntry; 3],
         scene: &'a LoadedScene,
     ) -> Result<SceneReferences<'a>> {
         let ctx = BuildContext { threads: o.threads };
-        let medium = registry::find(REFERENCES[0])?;
+        let [medium, robust, brute] = entries;
         let counts = QueryCounts {
             rays: o.rays,
             points: o.points,
         };
-        let run = SceneRun::prepare(scene, &o.workloads, counts, o.seed, o.threads, &medium)?;
+        let run = SceneRun::prepare(scene, &o.workloads, counts, o.seed, o.threads, medium)?;
         let mesh = &scene.scene.mesh;
-        let robust = registry::find(REFERENCES[1])?
-            .build(mesh.clone(), &ctx)?
-            .accel;
-        let brute = registry::find(REFERENCES[2])?
-            .build(mesh.clone(), &ctx)?
-            .accel;
+        let robust = robust.build(mesh.clone(), &ctx)?.accel;
+        let brute = brute.build(mesh.clone(), &ctx)?.accel;
         let mut workloads = Vec::new();
         for wl in &run.workloads {
             let any_hit = wl.workload.any_hit();

@@ -26,6 +26,8 @@ use std::borrow::Cow;
 /// Settings shared by every check of a run.
 pub(super) struct Checker<'a> {
     pub opts: &'a VerifyOptions,
+    /// The entries named by [`super::REFERENCES`], in that order.
+    pub references: &'a [StructureEntry; 3],
     pub tol: Tolerance,
     pub progress: &'a Progress,
 }

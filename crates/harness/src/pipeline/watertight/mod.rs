@@ -21,7 +21,7 @@ mod aimed;
 use super::measure::{Answers, trace_pass};
 use super::verify::brute_force_sample;
 use super::workers::{Workers, catch_panic};
-use crate::registry::{self, BuildContext, StructureEntry};
+use crate::registry::{BuildContext, Registry, StructureEntry};
 use crate::report::Header;
 use crate::report::watertight::{
     Case, CaseRecord, EMBREE_ROBUST_BAR, MissRate, Tally, WATERTIGHT_SCHEMA_VERSION,
@@ -121,10 +121,15 @@ fn count_misses(
     Ok(tally)
 }
 
-/// Runs every case through every structure.
+/// [`watertight_with`] the built-in structures.
 pub fn watertight(opts: &WatertightOptions) -> Result<WatertightReport> {
+    watertight_with(&Registry::builtin(), opts)
+}
+
+/// Runs every case through every structure, looking names up in `registry`.
+pub fn watertight_with(registry: &Registry, opts: &WatertightOptions) -> Result<WatertightReport> {
     ensure!(opts.rays >= 1, "--rays must be at least 1 (got 0)");
-    let entries = registry::select(&opts.structures)?;
+    let entries = registry.select(&opts.structures)?;
     let workers = Workers::start(opts.threads, false)?;
     let mut report = WatertightReport {
         header: Header::new(WATERTIGHT_SCHEMA_VERSION, workers.environment.clone()),
@@ -209,7 +214,7 @@ mod tests {
         let mut idx = mesh.indices().to_vec();
         idx.truncate(idx.len() / 2); // half a sphere: rays at the removed half miss
         let (half, _) = TriangleMesh::new(mesh.positions().to_vec(), idx).unwrap();
-        let brute = registry::find("bruteforce-watertight").unwrap();
+        let brute = Registry::builtin().find("bruteforce-watertight").unwrap();
         let opts = WatertightOptions {
             cases: vec![],
             structures: vec![],
