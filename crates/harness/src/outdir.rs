@@ -106,6 +106,29 @@ impl OutDir {
         })
     }
 
+    /// Claims the directory of an interrupted run to finish it (`raybench run --resume`): locked
+    /// like [`OutDir::claim`], but what the interrupted run wrote (its incomplete report and
+    /// the pictures of the scenes it finished) stays, to be completed.
+    pub fn claim_to_resume(dir: &Path) -> Result<OutDir> {
+        let lock =
+            File::open(dir).with_context(|| format!("{} cannot be opened", dir.display()))?;
+        match lock.try_lock() {
+            Ok(()) => {}
+            Err(TryLockError::WouldBlock) => bail!(
+                "{} is in use by another raybench command (it holds the directory's lock)",
+                dir.display()
+            ),
+            Err(TryLockError::Error(e)) => {
+                return Err(e).with_context(|| format!("locking {}", dir.display()));
+            }
+        }
+        prove_writable(dir)?;
+        Ok(OutDir {
+            path: dir.to_owned(),
+            _lock: lock,
+        })
+    }
+
     /// Claims a new directory `base/name`, or `base/name-2`, `-3`, … if that exists: a new run
     /// never lands in an earlier run's directory.
     pub fn claim_new(base: &Path, name: &str, outputs: &[Output]) -> Result<OutDir> {

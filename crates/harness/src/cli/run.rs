@@ -8,10 +8,11 @@ use crate::output::summary::summary_table;
 use crate::pipeline::picture;
 use crate::pipeline::run::{RunOptions, run_with};
 use crate::registry::Registry;
+use crate::report::run::Report;
 use anyhow::Result;
 use clap::Args;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Args, Debug)]
@@ -46,9 +47,16 @@ pub struct RunArgs {
     /// Write every ray and each structure's answer here (see docs/report-format.md, "Hit dumps").
     #[arg(long)]
     dump_hits: Option<PathBuf>,
+    /// Finish the interrupted run in DIR: the scenes its report.json lists as remaining, with
+    /// the settings it records (no other selection flag is taken), merged into that report.
+    #[arg(long, value_name = "DIR")]
+    resume: Option<PathBuf>,
 }
 
 pub fn run(registry: &Registry, args: RunArgs) -> Result<ExitCode> {
+    if let Some(dir) = args.resume.clone() {
+        return resume(registry, &args, &dir);
+    }
     let defaults = Defaults {
         structures: registry.names(),
         rays: 100_000,
@@ -86,14 +94,32 @@ pub fn run(registry: &Registry, args: RunArgs) -> Result<ExitCode> {
         picture_dir: Some(dir.to_path_buf()),
         picture_width: args.picture_width,
     };
+    crate::interrupt::stop_gracefully();
     let report = run_with(registry, &opts, &r.requests)?;
+    finish(report, dir, args.dump_hits.as_deref())
+}
+
+/// Writes the report; an interrupted one is written as it is, marked incomplete, and nothing
+/// is drawn (exit 130); a complete one is summarised and drawn.
+fn finish(report: Report, dir: &Path, dump_hits: Option<&Path>) -> Result<ExitCode> {
     let path = report.write_atomic(dir)?;
+    if let Some(inc) = &report.incomplete {
+        eprintln!(
+            "raybench: interrupted: {} written with the {} finished scene(s), marked incomplete \
+             ({} scene request(s) left); nothing drawn. Finish it with: raybench run --resume {}",
+            path.display(),
+            report.scenes.len(),
+            inc.remaining.len(),
+            dir.display()
+        );
+        return Ok(ExitCode::from(130));
+    }
     print!("{}", summary_table(&report));
     println!(
         "report: {}",
         raybench_scenes::printable(&path.display().to_string())
     );
-    if let Some(d) = &args.dump_hits {
+    if let Some(d) = dump_hits {
         println!(
             "hit dumps: {}",
             raybench_scenes::printable(&d.display().to_string())
@@ -131,6 +157,100 @@ pub fn run(registry: &Registry, args: RunArgs) -> Result<ExitCode> {
 
 /// `--picture-width`: a whole number of pixels within [`picture::MIN_WIDTH`] and
 /// [`picture::MAX_WIDTH`].
+/// `--resume DIR`: runs what DIR/report.json lists as remaining, with its settings, and merges
+/// the new scenes into it.
+fn resume(registry: &Registry, args: &RunArgs, dir: &Path) -> Result<ExitCode> {
+    let sel = &args.selection;
+    let given = [
+        ("--suite", sel.suite.is_some()),
+        ("--scenes", !sel.scenes.is_empty()),
+        ("--structures", !sel.structures.is_empty()),
+        ("--workloads", !sel.workloads.is_empty()),
+        ("--rays", sel.rays.is_some()),
+        ("--points", sel.points.is_some()),
+        ("--out", args.out.is_some()),
+        ("--dump-hits", args.dump_hits.is_some()),
+        ("--force", args.force),
+    ];
+    if let Some((flag, _)) = given.iter().find(|(_, on)| *on) {
+        anyhow::bail!(
+            "--resume takes every setting from {}/report.json: drop {flag}",
+            dir.display()
+        );
+    }
+    let path = dir.join("report.json");
+    let done = Report::read(&path)?;
+    let Some(incomplete) = done.incomplete.clone() else {
+        anyhow::bail!("--resume {}: {} is complete", dir.display(), path.display());
+    };
+    let (was, now) = (
+        &done.header.environment.git_revision,
+        crate::env::git_revision(),
+    );
+    anyhow::ensure!(
+        was == now,
+        "--resume {}: the report was written by revision {was} and this raybench is {now}; \
+         one report cannot mix two builds",
+        dir.display()
+    );
+    let claimed = outdir::OutDir::claim_to_resume(dir)?;
+    let rs = &done.run;
+    let workloads = rs
+        .workloads
+        .iter()
+        .map(|w| w.parse())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| anyhow::anyhow!("--resume {}: {e}", path.display()))?;
+    let opts = RunOptions {
+        suite: rs.suite.clone(),
+        structures: rs.structures.clone(),
+        suite_limits: rs.suite_limits,
+        workloads,
+        rays: rs.rays,
+        points: rs.points.max(1),
+        threads: rs.threads,
+        reference: rs.reference.clone(),
+        seed: rs.seed,
+        build_runs: rs.build_runs,
+        trace_runs: rs.trace_runs,
+        ftz_daz: rs.ftz_daz,
+        progress: std::io::stdout().is_terminal(),
+        images: rs.images,
+        dump_hits: None,
+        picture_dir: Some(claimed.path().to_path_buf()),
+        picture_width: if rs.picture_width == 0 {
+            picture::DEFAULT_WIDTH
+        } else {
+            rs.picture_width
+        },
+    };
+    let requests: Vec<_> = incomplete.remaining.iter().map(Into::into).collect();
+    crate::interrupt::stop_gracefully();
+    let more = run_with(registry, &opts, &requests)?;
+    finish(merge(done, more), claimed.path(), None)
+}
+
+/// The finished part of an interrupted run followed by the run that finished it: one report
+/// with the first run's header, incomplete only if the second was interrupted too. Ratios are
+/// per scene, so each part's stand; the claims are decided again on the whole.
+fn merge(mut done: Report, more: Report) -> Report {
+    done.scenes.extend(more.scenes);
+    done.results.extend(more.results);
+    done.notes.extend(more.notes);
+    done.errors.extend(more.errors);
+    done.pictures.extend(more.pictures);
+    done.notes.push(format!(
+        "resumed at {} (revision {}) after an interruption",
+        more.header.environment.timestamp, more.header.environment.git_revision
+    ));
+    done.incomplete = more.incomplete;
+    done.claims = crate::report::claims::evaluate(&done)
+        .into_iter()
+        .map(|e| e.claim)
+        .collect();
+    done
+}
+
 fn picture_width(text: &str) -> Result<u32, String> {
     let (lo, hi) = (picture::MIN_WIDTH, picture::MAX_WIDTH);
     match text.trim().parse::<u64>() {

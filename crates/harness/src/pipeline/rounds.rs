@@ -172,12 +172,13 @@ pub(super) fn rounds(opts: &RunOptions) -> usize {
 
 /// Times every pending structure in interleaved rounds and returns, in the order given, each
 /// structure's name with its result or what went wrong (a failed build or a panic in any round
-/// takes that structure out of the later rounds; the others go on).
+/// takes that structure out of the later rounds; the others go on). `None` when a graceful
+/// stop is asked for ([`crate::interrupt`]): checked before each structure's turn.
 pub(super) fn time_in_rounds(
     pending: Vec<Pending<'_>>,
     sr: &SceneRun,
     opts: &RunOptions,
-) -> Vec<(&'static str, Result<ResultEntry>)> {
+) -> Option<Vec<(&'static str, Result<ResultEntry>)>> {
     let n = pending.len();
     let mut failed: Vec<Option<anyhow::Error>> = (0..n).map(|_| None).collect();
     let mut pending = pending;
@@ -187,18 +188,22 @@ pub(super) fn time_in_rounds(
             if failed[i].is_some() {
                 continue;
             }
+            if crate::interrupt::requested() {
+                return None;
+            }
             let p = &mut pending[i];
             if let Err(e) = catch_panic(|| p.round(r, sr, opts)) {
                 failed[i] = Some(e.context(format!("timing round {}", r + 1)));
             }
         }
     }
-    pending
+    let results = pending
         .into_iter()
         .zip(failed)
         .map(|(p, f)| match f {
             None => (p.entry.name, Ok(p.finish())),
             Some(e) => (p.entry.name, Err(e)),
         })
-        .collect()
+        .collect();
+    Some(results)
 }

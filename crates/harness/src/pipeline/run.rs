@@ -16,6 +16,7 @@ use super::rounds::{self, Job, Pending};
 use super::scenes::for_each_scene;
 use super::workers::{Log, Progress, Workers, catch_panic};
 use super::workloads::{PreparedPoints, QueryCounts, SceneRun, prepare_workload, triangle_counts};
+use crate::interrupt;
 use crate::registry::{BuildContext, Registry, StructureEntry};
 use crate::report::Header;
 use crate::report::interval::{Interval, median_with_interval, paired_ratios};
@@ -125,6 +126,10 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
                 .map(|w| w.name().to_string())
                 .collect(),
             whitted: WhittedParams::default(),
+            images: opts.images,
+            suite_limits: opts.suite_limits,
+            ftz_daz: opts.ftz_daz,
+            picture_width: opts.picture_width,
         },
         scenes: Vec::new(),
         results: Vec::new(),
@@ -132,7 +137,10 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
         errors: Vec::new(),
         claims: Vec::new(),
         pictures: Vec::new(),
+        incomplete: None,
     };
+    // The request being measured (or next) when a graceful stop was asked for.
+    let mut stopped_at: Option<usize> = None;
     let mut picture_names = std::collections::HashSet::new();
     let picture_pool = opts
         .picture_dir()
@@ -140,7 +148,15 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
         .transpose()?;
 
     workers.pool.install(|| {
-        for_each_scene(scenes, opts.seed, &progress, &mut log, |_, scene, log| {
+        for_each_scene(scenes, opts.seed, &progress, &mut log, |request, scene, log| {
+            let index = scenes.iter().position(|r| std::ptr::eq(r, request)).unwrap_or(0);
+            if stopped_at.is_some() {
+                return;
+            }
+            if interrupt::requested() {
+                stopped_at = Some(index);
+                return;
+            }
             let name = &scene.scene.name;
             progress.step(format!("{name}: generating workloads with {}", reference_entry.name));
             let prepared = catch_panic(|| {
@@ -162,6 +178,9 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
             });
             let mut pending = Vec::new();
             for entry in &structures {
+                if interrupt::requested() {
+                    break;
+                }
                 if let Some(limit) = entry.suite_triangle_limit.filter(|&l| opts.suite_limits && scene.scene.mesh.len() > l) {
                     log.notes.push(format!(
                         "{} skipped on {name} ({} triangles > its suite limit {limit}); name it with --structures to run it",
@@ -189,7 +208,16 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
                 pending.push(p);
             }
             progress.step(format!("{name}: timing {} structures in {} interleaved rounds", pending.len(), rounds::rounds(opts)));
-            for (structure, timed) in rounds::time_in_rounds(pending, &sr, opts) {
+            // Stopped before every structure was timed: the scene is left out whole (a resumed
+            // run measures it again), so no result of it mixes finished and unfinished work.
+            let timed = (!interrupt::requested()).then(|| rounds::time_in_rounds(pending, &sr, opts)).flatten();
+            let Some(timed) = timed else {
+                stopped_at = Some(index);
+                report.scenes.pop();
+                log.notes.push(format!("{name}: interrupted while measured; left for --resume"));
+                return;
+            };
+            for (structure, timed) in timed {
                 match timed {
                     Ok(r) => report.results.push(r),
                     Err(e) => log.errors.push(format!("{structure} on {name}: {e:#}")),
@@ -204,6 +232,12 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
         });
     });
     progress.finish();
+    if let Some(i) = stopped_at {
+        report.incomplete = Some(Incomplete {
+            reason: "interrupted (SIGINT or SIGTERM)".into(),
+            remaining: scenes[i..].iter().map(RequestRecord::from).collect(),
+        });
+    }
     report.notes.append(&mut log.notes);
     report.errors.append(&mut log.errors);
     if let Some(dump) = dump {

@@ -37,6 +37,56 @@ pub struct Report {
     /// docs/report-format.md, "Pictures"); empty in older reports and runs without pictures.
     #[serde(default)]
     pub pictures: Vec<crate::pipeline::picture::PictureSet>,
+    /// Present when the run was interrupted: it holds the scenes it finished, and what is left
+    /// to run (`raybench run --resume DIR` runs it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub incomplete: Option<Incomplete>,
+}
+
+/// What an interrupted run left undone.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Incomplete {
+    pub reason: String,
+    /// The scene requests not finished, in order (the one being measured when the run stopped
+    /// first: its partial results are not in the report).
+    pub remaining: Vec<RequestRecord>,
+}
+
+/// A scene request as the run was given it, so a resumed run asks for the same scenes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RequestRecord {
+    /// A generator spec or an `.obj` path.
+    Spec(String),
+    /// A suite's OBJ entry (resolved path).
+    File {
+        path: std::path::PathBuf,
+        optional: bool,
+    },
+}
+
+impl From<&raybench_scenes::SceneRequest> for RequestRecord {
+    fn from(r: &raybench_scenes::SceneRequest) -> Self {
+        match r {
+            raybench_scenes::SceneRequest::Spec(s) => RequestRecord::Spec(s.clone()),
+            raybench_scenes::SceneRequest::File { path, optional } => RequestRecord::File {
+                path: path.clone(),
+                optional: *optional,
+            },
+        }
+    }
+}
+
+impl From<&RequestRecord> for raybench_scenes::SceneRequest {
+    fn from(r: &RequestRecord) -> Self {
+        match r {
+            RequestRecord::Spec(s) => raybench_scenes::SceneRequest::Spec(s.clone()),
+            RequestRecord::File { path, optional } => raybench_scenes::SceneRequest::File {
+                path: path.clone(),
+                optional: *optional,
+            },
+        }
+    }
 }
 
 /// The knobs of the run itself.
@@ -57,6 +107,22 @@ pub struct RunSettings {
     pub workloads: Vec<String>,
     /// Recursion control of the `whitted` workload.
     pub whitted: raybench_scenes::WhittedParams,
+    /// Keep per-pixel pictures (absent in older reports: true).
+    #[serde(default = "yes")]
+    pub images: bool,
+    /// Skip structures above their suite triangle limit (absent in older reports: false).
+    #[serde(default)]
+    pub suite_limits: bool,
+    /// Flush-to-zero and denormals-are-zero on every worker (absent in older reports: false).
+    #[serde(default)]
+    pub ftz_daz: bool,
+    /// Width of the full-resolution pictures (absent in older reports: 0, none drawn).
+    #[serde(default)]
+    pub picture_width: u32,
+}
+
+fn yes() -> bool {
+    true
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
