@@ -104,6 +104,15 @@ pub fn runs(text: &str) -> Result<usize, String> {
     }
 }
 
+/// `--time-budget`: seconds of timed passes per structure and scene, above 0 and at most an
+/// hour.
+pub fn seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if x > 0.0 && x <= 3600.0 => Ok(x),
+        _ => Err("must be a number of seconds above 0 and at most 3600".into()),
+    }
+}
+
 /// `--threads`: 1 to [`THREADS_PER_CORE`] × the cores of this machine.
 pub fn threads(text: &str) -> Result<usize, String> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());

@@ -51,6 +51,11 @@ pub struct RunArgs {
     /// the settings it records (no other selection flag is taken), merged into that report.
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
+    /// After the fixed rounds, keep timing a structure in extra rounds while one of its ratios
+    /// to the reference has a confidence interval wider than ±2 %, until its passes on the
+    /// scene have taken this many seconds (at most 1,000 rounds).
+    #[arg(long, value_name = "SECONDS", value_parser = super::bounds::seconds)]
+    time_budget: Option<f64>,
 }
 
 pub fn run(registry: &Registry, args: RunArgs) -> Result<ExitCode> {
@@ -87,6 +92,7 @@ pub fn run(registry: &Registry, args: RunArgs) -> Result<ExitCode> {
         seed: sel.seed,
         build_runs: args.build_runs,
         trace_runs: args.trace_runs,
+        time_budget: args.time_budget.map(std::time::Duration::from_secs_f64),
         ftz_daz: sel.ftz_daz,
         progress: std::io::stdout().is_terminal(),
         images: !args.no_images,
@@ -171,6 +177,7 @@ fn resume(registry: &Registry, args: &RunArgs, dir: &Path) -> Result<ExitCode> {
         ("--out", args.out.is_some()),
         ("--dump-hits", args.dump_hits.is_some()),
         ("--force", args.force),
+        ("--time-budget", args.time_budget.is_some()),
     ];
     if let Some((flag, _)) = given.iter().find(|(_, on)| *on) {
         anyhow::bail!(
@@ -213,6 +220,7 @@ fn resume(registry: &Registry, args: &RunArgs, dir: &Path) -> Result<ExitCode> {
         seed: rs.seed,
         build_runs: rs.build_runs,
         trace_runs: rs.trace_runs,
+        time_budget: rs.time_budget_s.map(std::time::Duration::from_secs_f64),
         ftz_daz: rs.ftz_daz,
         progress: std::io::stdout().is_terminal(),
         images: rs.images,

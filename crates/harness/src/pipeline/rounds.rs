@@ -14,6 +14,7 @@ use super::run::RunOptions;
 use super::workers::catch_panic;
 use super::workloads::SceneRun;
 use crate::registry::{BuildContext, Built, StructureEntry};
+use crate::report::interval::{median_with_interval, paired_ratios};
 use crate::report::run::{ResultEntry, Throughput, Timing};
 use anyhow::Result;
 use raybench_accel::{PointHit, PreparedRays};
@@ -119,9 +120,11 @@ impl<'e> Pending<'e> {
 
     /// Round `r`: one timed build (the new structure is dropped outside the timed window) while
     /// `r < build_runs`, and one timed pass of each workload that still has runs left.
-    fn round(&mut self, r: usize, sr: &SceneRun, opts: &RunOptions) -> Result<()> {
+    /// An `extra` round (past the fixed ones, see [`time_in_rounds`]) builds nothing and
+    /// traces every workload that is not timed once.
+    fn round(&mut self, r: usize, extra: bool, sr: &SceneRun, opts: &RunOptions) -> Result<()> {
         let mesh = &sr.scene.scene.mesh;
-        if r < opts.build_runs.max(1) {
+        if !extra && r < opts.build_runs.max(1) {
             let ctx = BuildContext {
                 threads: opts.threads,
             };
@@ -131,7 +134,8 @@ impl<'e> Pending<'e> {
             drop(next);
         }
         let accel = self.built.accel.as_ref();
-        for job in self.jobs.iter_mut().filter(|j| r < j.runs) {
+        let runs_now = |j: &Job| if extra { j.runs > 1 } else { r < j.runs };
+        for job in self.jobs.iter_mut().filter(|j| runs_now(j)) {
             let (queries, took) = match &mut job.kind {
                 JobKind::Rays {
                     workload,
@@ -170,10 +174,22 @@ pub(super) fn rounds(opts: &RunOptions) -> usize {
     opts.build_runs.max(opts.trace_runs).max(1)
 }
 
+/// The precision extra rounds aim for: every ratio's interval within ±2 % of it.
+const TARGET_HALF_WIDTH: f64 = 0.02;
+
+/// The most rounds a scene takes, fixed and extra together.
+const MAX_ROUNDS: usize = 1000;
+
 /// Times every pending structure in interleaved rounds and returns, in the order given, each
 /// structure's name with its result or what went wrong (a failed build or a panic in any round
 /// takes that structure out of the later rounds; the others go on). `None` when a graceful
 /// stop is asked for ([`crate::interrupt`]): checked before each structure's turn.
+///
+/// With a time budget (`opts.time_budget`, seconds per structure and scene), the fixed rounds
+/// are followed by extra ones, traces only, as criterion and hyperfine adapt their sample
+/// counts: a structure takes part while one of its ratios to the reference has an interval
+/// wider than ±[`TARGET_HALF_WIDTH`] and its timed passes have used less than the budget; the
+/// reference takes part while anyone does, so every structure's rounds pair with its rounds.
 pub(super) fn time_in_rounds(
     pending: Vec<Pending<'_>>,
     sr: &SceneRun,
@@ -181,20 +197,34 @@ pub(super) fn time_in_rounds(
 ) -> Option<Vec<(&'static str, Result<ResultEntry>)>> {
     let n = pending.len();
     let mut failed: Vec<Option<anyhow::Error>> = (0..n).map(|_| None).collect();
+    let mut spent = vec![Duration::ZERO; n];
     let mut pending = pending;
-    for r in 0..rounds(opts) {
+    let fixed = rounds(opts);
+    let reference = pending.iter().position(|p| p.entry.name == opts.reference);
+    for r in 0..MAX_ROUNDS {
+        let extra = r >= fixed;
+        let active: Vec<bool> = if extra {
+            wanting_more(&pending, reference, &spent, opts)
+        } else {
+            vec![true; n]
+        };
+        if !active.iter().any(|&a| a) {
+            break;
+        }
         for k in 0..n {
             let i = (k + r) % n;
-            if failed[i].is_some() {
+            if failed[i].is_some() || !active[i] {
                 continue;
             }
             if crate::interrupt::requested() {
                 return None;
             }
             let p = &mut pending[i];
-            if let Err(e) = catch_panic(|| p.round(r, sr, opts)) {
+            let start = Instant::now();
+            if let Err(e) = catch_panic(|| p.round(r, extra, sr, opts)) {
                 failed[i] = Some(e.context(format!("timing round {}", r + 1)));
             }
+            spent[i] += start.elapsed();
         }
     }
     let results = pending
@@ -206,4 +236,46 @@ pub(super) fn time_in_rounds(
         })
         .collect();
     Some(results)
+}
+
+/// Which structures take part in the next extra round (see [`time_in_rounds`]).
+fn wanting_more(
+    pending: &[Pending<'_>],
+    reference: Option<usize>,
+    spent: &[Duration],
+    opts: &RunOptions,
+) -> Vec<bool> {
+    let n = pending.len();
+    let (Some(budget), Some(ref_i)) = (opts.time_budget, reference) else {
+        return vec![false; n];
+    };
+    let base = &pending[ref_i];
+    let mut active: Vec<bool> = (0..n)
+        .map(|i| {
+            i != ref_i
+                && spent[i] < budget
+                && pending[i].jobs.iter().filter(|j| j.runs > 1).any(|j| {
+                    let Some(b) = base.jobs.iter().find(|b| b.kind.same_workload(&j.kind)) else {
+                        return false;
+                    };
+                    let ratios = paired_ratios(&j.samples, &b.samples);
+                    match median_with_interval(&ratios) {
+                        Some((m, Some(i))) => i.relative_half_width(m) > TARGET_HALF_WIDTH,
+                        _ => false,
+                    }
+                })
+        })
+        .collect();
+    active[ref_i] = active.iter().any(|&a| a);
+    active
+}
+
+impl JobKind {
+    fn same_workload(&self, o: &JobKind) -> bool {
+        match (self, o) {
+            (JobKind::Rays { workload: a, .. }, JobKind::Rays { workload: b, .. }) => a == b,
+            (JobKind::Points { workload: a, .. }, JobKind::Points { workload: b, .. }) => a == b,
+            _ => false,
+        }
+    }
 }

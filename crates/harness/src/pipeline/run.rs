@@ -44,6 +44,9 @@ pub struct RunOptions {
     pub seed: u64,
     pub build_runs: usize,
     pub trace_runs: usize,
+    /// Extra timing rounds per scene while a structure's ratios are imprecise, up to this
+    /// much of its passes' time (see `rounds.rs`); `None` for the fixed rounds only.
+    pub time_budget: Option<std::time::Duration>,
     pub ftz_daz: bool,
     pub progress: bool,
     /// Keep per-pixel pictures of the primary workload in the report (see `images`); off for
@@ -118,6 +121,7 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
             reference: opts.reference.clone(),
             build_runs: opts.build_runs,
             trace_runs: opts.trace_runs,
+            time_budget_s: opts.time_budget.map(|d| d.as_secs_f64()),
             tolerance: tol,
             structures: structures.iter().map(|e| e.name.to_string()).collect(),
             workloads: opts

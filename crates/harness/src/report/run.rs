@@ -102,6 +102,9 @@ pub struct RunSettings {
     pub reference: String,
     pub build_runs: usize,
     pub trace_runs: usize,
+    /// `--time-budget` in seconds: extra rounds while ratios are imprecise (absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_budget_s: Option<f64>,
     pub tolerance: Tolerance,
     pub structures: Vec<String>,
     pub workloads: Vec<String>,

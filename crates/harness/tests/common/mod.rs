@@ -19,6 +19,7 @@ pub fn options(structures: &[&str]) -> RunOptions {
         seed: 7,
         build_runs: 1,
         trace_runs: 1,
+        time_budget: None,
         ftz_daz: false,
         progress: false,
         images: true,
