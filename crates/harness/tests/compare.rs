@@ -105,7 +105,11 @@ fn a_slowdown_beyond_the_threshold_fails_unless_advisory() {
     w.speedup_vs_reference = Some(s / 1.2); // 20 % slower
     w.speedup_interval = Some(narrow(s / 1.2));
     let regressions = |opts: &CompareOptions| compare(&old, &new, opts).regressions();
-    let strict = CompareOptions::default();
+    // One scene: the per-scene threshold decides.
+    let strict = CompareOptions {
+        max_scene_slowdown: 0.10,
+        ..CompareOptions::default()
+    };
     let c = compare(&old, &new, &strict);
     assert!(
         c.findings.iter().any(|f| f.what.contains("Mrays/s ratio")),
@@ -114,7 +118,7 @@ fn a_slowdown_beyond_the_threshold_fails_unless_advisory() {
     );
     assert_eq!(regressions(&strict), 1, "{}", text(&c));
     let lenient = CompareOptions {
-        max_slowdown: 0.25,
+        max_scene_slowdown: 0.25,
         ..strict
     };
     assert_eq!(regressions(&lenient), 0);
@@ -149,11 +153,11 @@ fn a_slowdown_within_the_noise_is_advisory_and_a_significant_one_fails() {
         let w = &mut bvh(&mut new).workloads[0];
         w.speedup_vs_reference = Some(s / 1.3); // 30 % slower
         w.speedup_interval = Some(interval(s / 1.3, half));
-        let c = compare(
-            &with_base_interval(interval(s, half)),
-            &new,
-            &CompareOptions::default(),
-        );
+        let opts = CompareOptions {
+            max_scene_slowdown: 0.10,
+            ..CompareOptions::default()
+        };
+        let c = compare(&with_base_interval(interval(s, half)), &new, &opts);
         let f = c
             .findings
             .iter()
@@ -415,4 +419,84 @@ fn json_and_junit_carry_the_verdict_and_the_failing_row() {
     let v: serde_json::Value = serde_json::from_str(&json(&same, &opts, false)).unwrap();
     assert_eq!(v["verdict"], "pass");
     assert!(junit(&same).contains("failures=\"0\""));
+}
+
+/// `base()` with its one scene repeated under a second name, every ratio given a ±1 % interval.
+fn two_scenes() -> Report {
+    let mut r = base().clone();
+    let copies: Vec<_> = r
+        .results
+        .iter()
+        .cloned()
+        .map(|mut e| {
+            e.scene = "soup-again".into();
+            e
+        })
+        .collect();
+    r.results.extend(copies);
+    for e in &mut r.results {
+        for w in &mut e.workloads {
+            let x = w.speedup_vs_reference.unwrap();
+            w.speedup_interval = Some(Interval {
+                lo: x * 0.99,
+                hi: x * 1.01,
+                level: 0.9375,
+            });
+        }
+    }
+    r
+}
+
+/// Slows bvh-binned's primary rays by `factor` on the scenes named.
+fn slowed(report: &Report, factor: f64, scenes: &[&str]) -> Report {
+    let mut r = report.clone();
+    for e in r.results.iter_mut().filter(|e| e.structure == "bvh-binned") {
+        if !scenes.contains(&e.scene.as_str()) {
+            continue;
+        }
+        let w = e
+            .workloads
+            .iter_mut()
+            .find(|w| w.workload == "primary")
+            .unwrap();
+        let x = w.speedup_vs_reference.unwrap() / factor;
+        w.speedup_vs_reference = Some(x);
+        w.speedup_interval = Some(Interval {
+            lo: x * 0.99,
+            hi: x * 1.01,
+            level: 0.9375,
+        });
+    }
+    r
+}
+
+#[test]
+fn the_geometric_mean_gates_and_one_scene_alone_is_advisory() {
+    let base = two_scenes();
+    let opts = CompareOptions::default();
+    // 30 % slower everywhere: the geometric mean fails, significantly.
+    let c = compare(
+        &base,
+        &slowed(&base, 1.3, &["soup:triangles=300", "soup-again"]),
+        &opts,
+    );
+    let failing: Vec<&str> = c
+        .findings
+        .iter()
+        .filter(|f| f.severity == Severity::Regression)
+        .map(|f| f.what.as_str())
+        .collect();
+    assert_eq!(failing.len(), 1, "{failing:?}");
+    assert!(failing[0].contains("bvh-binned / primary (geometric mean over 2 scenes)"));
+    assert!(failing[0].contains("30.0 % slower") && failing[0].contains("significant"));
+    // 15 % slower on one scene: the mean moves 7 %, the scene stays under its 50 %.
+    let c = compare(&base, &slowed(&base, 1.15, &["soup-again"]), &opts);
+    assert_eq!(c.regressions(), 0, "{}", text(&c));
+    assert!(c.findings.iter().any(|f| f.severity == Severity::Advisory
+        && f.what.contains("soup-again / bvh-binned / primary")
+        && f.what.contains("gated by the geometric mean")));
+    // 2× slower on one scene: beyond the per-scene threshold, and significant.
+    let c = compare(&base, &slowed(&base, 2.0, &["soup-again"]), &opts);
+    assert!(c.findings.iter().any(|f| f.severity == Severity::Regression
+        && f.what.starts_with("soup-again / bvh-binned / primary")));
 }
