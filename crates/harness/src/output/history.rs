@@ -137,13 +137,17 @@ fn one_series(entries: &[Entry], structure: String, workload: String) -> Series 
             .collect();
         if !changed.is_empty() {
             let settings = a.run.seed != b.run.seed || a.run.rays != b.run.rays;
+            // A few names are enough to find the rest in the reports.
+            let mut named = changed[..changed.len().min(3)].join(", ");
+            if changed.len() > 3 {
+                named.push_str(&format!(", and {} more", changed.len() - 3));
+            }
             events.push((
                 i,
                 format!(
-                    "counters changed on {} of {} scenes ({}){}",
+                    "counters changed on {} of {} scenes ({named}){}",
                     changed.len(),
                     scenes.len(),
-                    changed.join(", "),
                     if settings {
                         "; the run settings differ too"
                     } else {
