@@ -64,7 +64,7 @@ fn events_are_marked_where_they_happened() {
                 }
                 w.speedup_vs_reference = Some(x);
                 w.speedup_interval = Some(narrow(x));
-                if rev >= "cccc".to_string()
+                if rev.as_str() >= "cccc"
                     && r.structure == "grid"
                     && r.scene.starts_with("soup")
                     && w.workload == "primary"
