@@ -149,9 +149,13 @@ fn bar_charts(report: &Report, palette: &Palette) -> Result<Vec<Figure>> {
     )?;
     push(
         "ratio-build.svg".into(),
-        format!("Build time relative to {reference} in the same run (lower is faster)"),
+        format!(
+            "Build time relative to {reference} in the same run (lower is faster; error bars: \
+             the ratio's confidence interval over the rounds)"
+        ),
         &bars(format!("Build time / {reference}"), "ratio", &|r| {
-            plain(r.build_ratio_to_reference)
+            let band = r.build_ratio_interval.map(|i| (i.lo, i.hi));
+            r.build_ratio_to_reference.map(|x| (x, band))
         }),
     )?;
     for wl in workload_names(report) {
@@ -174,10 +178,13 @@ fn bar_charts(report: &Report, palette: &Palette) -> Result<Vec<Figure>> {
         push(
             format!("ratio-{}.svg", slug(&wl)),
             format!(
-                "Throughput on `{wl}` relative to {reference} in the same run (higher is faster)"
+                "Throughput on `{wl}` relative to {reference} in the same run (higher is faster; \
+                 error bars: the ratio's confidence interval over the rounds)"
             ),
             &bars(format!("{wl}: {unit} / {reference}"), "ratio", &|r| {
-                plain(find(r).and_then(|w| w.speedup_vs_reference))
+                let w = find(r)?;
+                let band = w.speedup_interval.map(|i| (i.lo, i.hi));
+                w.speedup_vs_reference.map(|x| (x, band))
             }),
         )?;
     }
