@@ -135,7 +135,8 @@ pub fn markdown(
         s,
         "base: {} ({}), new: {} ({}). Ratios are to `{}` in the same run; a change is written \
          as a slowdown (time per query or per build, relative to the reference). Timing \
-         threshold {:.0} %{}, significance-tested where both reports carry confidence \
+         thresholds: {:.0} % for a structure × workload's geometric mean over the scenes, \
+         {:.0} % for one scene{}; significance-tested where both reports carry confidence \
          intervals.\n",
         base.header.environment.git_revision,
         base.header.environment.timestamp,
@@ -143,6 +144,7 @@ pub fn markdown(
         new.header.environment.timestamp,
         new.run.reference,
         opts.max_slowdown * 100.0,
+        opts.max_scene_slowdown * 100.0,
         if opts.timing_advisory {
             ", advisory"
         } else {
