@@ -187,8 +187,19 @@ fn headline_table(report: &Report, reference: &str) -> String {
     let rows = headline_rows_to(report, reference);
     for row in &rows {
         let _ = write!(s, "| {} |", row.structure);
-        for w in &row.workloads {
-            let _ = write!(s, " {} |", cell(*w));
+        for (w, name) in row.workloads.iter().zip(workloads) {
+            // A workload the structure cannot answer on any scene: said, never a number.
+            let refused = report
+                .results
+                .iter()
+                .filter(|r| r.structure == row.structure)
+                .all(|r| r.not_offered.contains(name));
+            match w {
+                None if refused => s.push_str(" not offered |"),
+                _ => {
+                    let _ = write!(s, " {} |", cell(*w));
+                }
+            }
         }
         let _ = writeln!(s, " {} | {} |", cell(row.build), cell(row.memory));
     }
@@ -373,6 +384,7 @@ fn scene_tables(s: &mut String, report: &Report) {
                             cell(w.speedup_vs_reference)
                         );
                     }
+                    None if r.not_offered.contains(wl) => s.push_str(" not offered |"),
                     None => s.push_str(" - |"),
                 }
             }
