@@ -181,7 +181,7 @@ fn run_times_and_checks_a_registered_entry_and_reports_its_params() {
 }
 
 #[test]
-fn verify_defaults_to_every_entry_including_registered_ones() {
+fn verify_defaults_to_every_entry_but_the_peers_including_registered_ones() {
     let dir = common::scratch("registry-verify");
     let args = Verify::parse_from([
         "verify",
@@ -201,7 +201,14 @@ fn verify_defaults_to_every_entry_including_registered_ones() {
     let text = std::fs::read_to_string(dir.join("verify.json")).unwrap();
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
     let structures = json["settings"]["structures"].as_array().unwrap();
-    assert_eq!(structures.len(), with_mine().names().len());
+    let registry = with_mine();
+    let own = registry.entries().iter().filter(|e| !e.peer).count();
+    assert_eq!(structures.len(), own);
+    assert!(
+        structures
+            .iter()
+            .all(|s| !s.as_str().unwrap().starts_with("peer-"))
+    );
     assert_eq!(structures.last().unwrap(), "my-bvh");
 }
 

@@ -44,7 +44,7 @@ enum Command {
     /// × workload (ratio with its interval, work per query) and a Markdown summary marking
     /// where counters changed or a ratio left its interval.
     History(super::history::HistoryArgs),
-    /// Check answers, not speed: every structure (default: all registered) × scene × workload
+    /// Check answers, not speed: every structure (default: all registered but the peers) × scene × workload
     /// against embree-medium, embree-robust and brute force; write DIR/verify.json. Exit 0
     /// with no mismatch, 2 on any mismatch, 1 on errors.
     Verify(super::verify::VerifyArgs),
