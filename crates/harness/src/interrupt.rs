@@ -36,8 +36,3 @@ pub fn stop_gracefully() {
 pub fn requested() -> bool {
     REQUESTED.load(Ordering::SeqCst)
 }
-
-/// Asks for a graceful stop as a signal would (tests).
-pub fn request() {
-    REQUESTED.store(true, Ordering::SeqCst);
-}
