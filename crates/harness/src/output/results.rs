@@ -150,6 +150,26 @@ fn scenes(report: &Report) -> Vec<String> {
     names
 }
 
+/// Writes a heading row once, before the first peer (`peer-*`: another crate's structure,
+/// registered last), so a table shows raybench's structures and the peers apart.
+#[derive(Default)]
+struct PeersHeading {
+    written: bool,
+}
+
+impl PeersHeading {
+    fn before(&mut self, s: &mut String, structure: &str, cells: usize) {
+        if !self.written && structure.starts_with("peer-") {
+            self.written = true;
+            let _ = writeln!(
+                s,
+                "| *peers: other crates' structures* |{}",
+                " |".repeat(cells)
+            );
+        }
+    }
+}
+
 /// A ratio with two decimals; one too small for two decimals to show in scientific notation
 /// (brute force runs at about 1e-4 of the reference's speed).
 pub fn ratio_text(x: f64) -> String {
@@ -185,7 +205,9 @@ fn headline_table(report: &Report, reference: &str) -> String {
     s.push_str(&"---:|".repeat(workloads.len() + 2));
     s.push('\n');
     let rows = headline_rows_to(report, reference);
+    let mut peers_heading = PeersHeading::default();
     for row in &rows {
+        peers_heading.before(&mut s, &row.structure, workloads.len() + 2);
         let _ = write!(s, "| {} |", row.structure);
         for (w, name) in row.workloads.iter().zip(workloads) {
             // A workload the structure cannot answer on any scene: said, never a number.
@@ -365,7 +387,9 @@ fn scene_tables(s: &mut String, report: &Report) {
         s.push_str("\n|---|");
         s.push_str(&"---:|".repeat(workloads.len() + 2));
         s.push('\n');
+        let mut peers_heading = PeersHeading::default();
         for r in entries {
+            peers_heading.before(s, &r.structure, workloads.len() + 2);
             let _ = write!(
                 s,
                 "| {} | {} ({}) | {} |",

@@ -43,7 +43,13 @@ pub fn summary_table(report: &Report) -> String {
         let _ = write!(out, " {:>10} {:>7}", format!("{w} {unit}"), "x ref");
     }
     let _ = writeln!(out, " {:>9} {:>9}", "ambig.", "mismatch");
+    // Other crates' structures (`peer-*`, registered last) under their own line in each scene.
+    let mut peers_of: Option<&str> = None;
     for r in &report.results {
+        if r.structure.starts_with("peer-") && peers_of != Some(r.scene.as_str()) {
+            peers_of = Some(&r.scene);
+            let _ = writeln!(out, "{:<sw$} -- peers: other crates' structures --", "");
+        }
         let _ = write!(
             out,
             "{:<sw$} {:<22} {:>10} {:>7}",
