@@ -11,9 +11,18 @@ use raybench_geom::{Ray, Vec3};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
-/// Queries per rayon task when tracing with several threads: large enough that scheduling
-/// costs are noise (~1 µs per task vs ≥ 25 µs of tracing), small enough to balance 2 cores.
+/// Queries per structure call when tracing with several threads: large enough that the call's
+/// setup is noise, small enough to balance 2 cores. Rayon gets at most [`CHUNKS_PER_TASK`] of
+/// them per task.
 const CHUNK: usize = 256;
+
+/// Chunks per rayon task (`with_max_len`): about 25–100 µs of tracing, ~1 µs of scheduling.
+/// Left to itself, rayon cut a batch into a few long runs of chunks up front, and a thread
+/// that had finished its runs could not take over part of another's, so a batch whose cheap
+/// rays (misses around a small object) sat in one half ran partly on one thread: the teapot's
+/// primary rays traced 1.76× faster on 2 threads than on 1, now 1.97× (measured: see
+/// docs/experiments.md, "rayon tasks of at most four chunks").
+const CHUNKS_PER_TASK: usize = 4;
 
 /// A warm-up pass longer than this is measured once more, not `trace_runs` times: a pass that
 /// long already averages over thousands of scheduler ticks, and repeating it (brute force, or
@@ -79,10 +88,12 @@ pub fn trace_pass(
         Answers::Any(occ) if threads <= 1 => accel.occluded_prepared(rays, prepared, 0, occ),
         Answers::Closest(hits) => hits
             .par_chunks_mut(CHUNK)
+            .with_max_len(CHUNKS_PER_TASK)
             .enumerate()
             .for_each(|(i, chunk)| accel.intersect_prepared(rays, prepared, i * CHUNK, chunk)),
         Answers::Any(occ) => occ
             .par_chunks_mut(CHUNK)
+            .with_max_len(CHUNKS_PER_TASK)
             .enumerate()
             .for_each(|(i, chunk)| accel.occluded_prepared(rays, prepared, i * CHUNK, chunk)),
     }
@@ -117,6 +128,7 @@ pub fn point_pass(
         accel.closest_points(points, radius, 0, out);
     } else {
         out.par_chunks_mut(CHUNK)
+            .with_max_len(CHUNKS_PER_TASK)
             .enumerate()
             .for_each(|(i, chunk)| accel.closest_points(points, radius, i * CHUNK, chunk));
     }
