@@ -16,7 +16,9 @@
 //!
 //! `cargo run --release -p raybench-harness --example build_time -- ../shared/scenes/stanford-bunny.obj 2 21`
 //! (scene: an .obj path or a generator spec such as `city`; threads; rounds; optionally a label
-//! filter). Under `valgrind --tool=callgrind` use 1 round.
+//! filter). Under `valgrind --tool=callgrind` use 1 round. `GAP_MS=N` in the environment sleeps
+//! N ms before each timed build, so that no pool's idle workers (rayon's, or Embree's own
+//! after its build) are still spinning when the next build starts.
 
 use raybench_accel::Accel;
 use raybench_bvh::{Bvh, Bvh8, BvhParams, WideParams};
@@ -105,11 +107,18 @@ fn main() {
         .filter(|(k, (label, _))| *k == 0 || only.as_deref().is_none_or(|o| label.contains(o)))
         .map(|(_, s)| s)
         .collect();
+    let gap = std::time::Duration::from_millis(
+        std::env::var("GAP_MS")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(0),
+    );
     let mut ms = vec![Vec::new(); structures.len()];
     pool.install(|| {
         // Round 0 warms up (page faults, caches, rayon's workers) and is not counted.
         for round in 0..=rounds {
             for (k, (_, build)) in structures.iter().enumerate() {
+                std::thread::sleep(gap);
                 let start = Instant::now();
                 let built = build();
                 let elapsed = start.elapsed().as_secs_f64() * 1e3;
