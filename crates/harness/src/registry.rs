@@ -67,6 +67,12 @@ impl std::fmt::Debug for StructureEntry {
     }
 }
 
+/// Whether a structure named in a report is a peer (another crate's structure): reports keep
+/// names only, and every peer's name starts with `peer-`.
+pub fn is_peer_name(structure: &str) -> bool {
+    structure.starts_with("peer-")
+}
+
 impl StructureEntry {
     pub fn build(&self, mesh: Arc<TriangleMesh>, ctx: &BuildContext) -> Result<Built, BuildError> {
         (self.builder)(mesh, ctx)

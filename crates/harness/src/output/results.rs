@@ -159,7 +159,7 @@ struct PeersHeading {
 
 impl PeersHeading {
     fn before(&mut self, s: &mut String, structure: &str, cells: usize) {
-        if !self.written && structure.starts_with("peer-") {
+        if !self.written && crate::registry::is_peer_name(structure) {
             self.written = true;
             let _ = writeln!(
                 s,

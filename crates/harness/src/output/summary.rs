@@ -46,7 +46,7 @@ pub fn summary_table(report: &Report) -> String {
     // Other crates' structures (`peer-*`, registered last) under their own line in each scene.
     let mut peers_of: Option<&str> = None;
     for r in &report.results {
-        if r.structure.starts_with("peer-") && peers_of != Some(r.scene.as_str()) {
+        if crate::registry::is_peer_name(&r.structure) && peers_of != Some(r.scene.as_str()) {
             peers_of = Some(&r.scene);
             let _ = writeln!(out, "{:<sw$} -- peers: other crates' structures --", "");
         }

@@ -168,18 +168,26 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
     let (b, n) = (keyed(base), keyed(new));
     let mut rows = Vec::new();
     let mut not_run = 0usize;
+    // What the base has and the new report lacks: "not run" with `--subset`, else a regression.
+    let mut missing = |at: &str, what: &str, findings: &mut Vec<Finding>| {
+        if opts.subset {
+            not_run += 1;
+        } else {
+            findings.push(Finding::about(
+                Severity::Regression,
+                at,
+                format!("{at}: {what}"),
+            ));
+        }
+    };
     for (key, be) in &b {
         let at = format!("{} / {}", key.0, key.1);
         let Some(ne) = n.get(key) else {
-            if opts.subset {
-                not_run += 1;
-            } else {
-                findings.push(Finding::about(
-                    Severity::Regression,
-                    at.clone(),
-                    format!("{at}: in the base, missing from the new report"),
-                ));
-            }
+            missing(
+                &at,
+                "in the base, missing from the new report",
+                &mut findings,
+            );
             continue;
         };
         if comparable {
@@ -189,15 +197,11 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
         for bw in &be.workloads {
             let label = format!("{at} / {}", bw.workload);
             let Some(nw) = ne.workloads.iter().find(|w| w.workload == bw.workload) else {
-                if opts.subset {
-                    not_run += 1;
-                } else {
-                    findings.push(Finding::about(
-                        Severity::Regression,
-                        label.clone(),
-                        format!("{label}: workload missing from the new report"),
-                    ));
-                }
+                missing(
+                    &label,
+                    "workload missing from the new report",
+                    &mut findings,
+                );
                 continue;
             };
             let is_reference = key.1 == new.run.reference;
