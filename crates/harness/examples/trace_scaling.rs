@@ -16,10 +16,8 @@ use raybench_harness::registry::BuildContext;
 use raybench_scenes::{SurfaceHit, Workload};
 use std::time::Duration;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+mod probe;
+use probe::median;
 
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()

@@ -1,5 +1,5 @@
-//! What the knob probes (`grid2tune`, `octtune`, `skiptune`) share: a scene with its seeded
-//! random and primary rays, and a timed pass.
+//! What the knob probes (`grid2tune`, `octtune`, `skiptune`; `trace_scaling` for its median)
+//! share: a scene with its seeded random and primary rays, a median, and a timed pass.
 
 use raybench_accel::{Accel, Counters};
 use raybench_geom::{Ray, TriangleMesh};
