@@ -173,7 +173,8 @@ fn filling_slots_splits_leaves_and_lowers_the_sah() {
 }
 
 /// The wide trees do not depend on the thread count: the collapse runs its larger subtrees on
-/// rayon and appends each child's nodes in slot order, as one thread makes them.
+/// rayon and places each child's nodes after its parent in slot order, as one thread makes
+/// them.
 #[test]
 fn wide_trees_are_the_same_with_one_and_two_threads() {
     fn check<const W: usize>(mesh: &std::sync::Arc<raybench_geom::TriangleMesh>) {

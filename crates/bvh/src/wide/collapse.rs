@@ -161,13 +161,133 @@ fn split_leaf(refs: &mut [PrimRef], first: u32) -> [(ChildRef, Aabb); 2] {
     [leaf(0, cut, left), leaf(cut, n - cut, right[cut])]
 }
 
+/// Collapses the whole binary tree (root `r`, triangles `refs` from record 0) into wide
+/// nodes, depth-first; returns them with the reference to the root. Subtrees of
+/// [`PARALLEL_COLLAPSE`] triangles or more collapse their children on rayon into separate
+/// pieces ([`Piece`]); once every piece is done, each is copied exactly once into its place
+/// in the final array, in parallel too. The nodes and their order are the ones one thread
+/// makes.
+pub(super) fn collapse_tree<const W: usize>(
+    b: &Binary,
+    refs: &mut [PrimRef],
+    r: ChildRef,
+) -> (Vec<WideNode<W>>, ChildRef) {
+    use rayon::prelude::*;
+    let piece = piece::<W>(b, refs, 0, r);
+    let mut nodes: Vec<WideNode<W>> = (0..piece.len())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|_| WideNode::empty())
+        .collect();
+    let root = place(piece, &mut nodes, 0);
+    (nodes, root)
+}
+
+/// A collapsed subtree as the parallel collapse returns it.
+enum Piece<const W: usize> {
+    /// Collapsed by one task: nodes depth-first from local index 0 whose interior child
+    /// references are local too, or a leaf (`nodes` empty).
+    Local {
+        nodes: Vec<WideNode<W>>,
+        root: ChildRef,
+    },
+    /// A node whose children were collapsed on rayon (slot order), with its boxes set and
+    /// its child references left to [`place`]; `len` counts the nodes of the whole piece.
+    Fork {
+        node: WideNode<W>,
+        children: Vec<Piece<W>>,
+        len: usize,
+    },
+}
+
+impl<const W: usize> Piece<W> {
+    fn len(&self) -> usize {
+        match self {
+            Piece::Local { nodes, .. } => nodes.len(),
+            Piece::Fork { len, .. } => *len,
+        }
+    }
+}
+
+fn piece<const W: usize>(b: &Binary, refs: &mut [PrimRef], start: u32, r: ChildRef) -> Piece<W> {
+    use rayon::prelude::*;
+    if r.is_leaf() || refs.len() < PARALLEL_COLLAPSE {
+        let mut nodes = Vec::new();
+        let root = collapse(b, refs, start, r, &mut nodes);
+        return Piece::Local { nodes, root };
+    }
+    let (kids, len) = b.open::<W>(refs, start, r);
+    let mut node = WideNode::empty();
+    let mut jobs = Vec::with_capacity(len);
+    let (mut rest, mut first) = (refs, start);
+    for (slot, &(child, bounds)) in kids[..len].iter().enumerate() {
+        node.set_child(slot, &bounds, ChildRef::default());
+        let size = b.size(child);
+        let (mine, tail) = std::mem::take(&mut rest).split_at_mut(size);
+        jobs.push((child, mine, first));
+        rest = tail;
+        first += size as u32;
+    }
+    let children: Vec<Piece<W>> = jobs
+        .into_par_iter()
+        .map(|(child, mine, first)| piece(b, mine, first, child))
+        .collect();
+    let len = 1 + children.iter().map(Piece::len).sum::<usize>();
+    Piece::Fork {
+        node,
+        children,
+        len,
+    }
+}
+
+/// Writes `piece` into `out` (exactly its length), whose first node has index `base` in the
+/// final array; returns the reference to the piece's root.
+fn place<const W: usize>(piece: Piece<W>, out: &mut [WideNode<W>], base: u32) -> ChildRef {
+    use rayon::prelude::*;
+    match piece {
+        Piece::Local { root, .. } if root.is_leaf() => root,
+        Piece::Local { nodes, root } => {
+            for (o, mut node) in out.iter_mut().zip(nodes) {
+                let used = node.children();
+                for c in node.child[..used].iter_mut().filter(|c| !c.is_leaf()) {
+                    c.index += base;
+                }
+                *o = node;
+            }
+            ChildRef {
+                index: base + root.index,
+                count: 0,
+            }
+        }
+        Piece::Fork { node, children, .. } => {
+            let (head, mut rest) = out.split_first_mut().expect("a fork has its own node");
+            *head = node;
+            let mut jobs = Vec::with_capacity(children.len());
+            let mut at = base + 1;
+            for child in children {
+                let len = child.len();
+                let (mine, tail) = std::mem::take(&mut rest).split_at_mut(len);
+                jobs.push((child, mine, at));
+                at += len as u32;
+                rest = tail;
+            }
+            let refs: Vec<ChildRef> = jobs
+                .into_par_iter()
+                .map(|(child, mine, at)| place(child, mine, at))
+                .collect();
+            head.child[..refs.len()].copy_from_slice(&refs);
+            ChildRef {
+                index: base,
+                count: 0,
+            }
+        }
+    }
+}
+
 /// Collapses the binary subtree `r`, whose triangles are `refs` (the first of them record
-/// `start`), into wide nodes appended to `out` depth-first. Leaves stay triangle ranges
-/// (`{ index: first record, count }`) until [`number_tri4s`]. A subtree of
-/// [`PARALLEL_COLLAPSE`] triangles or more collapses its children on rayon, each into a
-/// vector of its own, appended in slot order afterwards: the same nodes in the same order as
-/// one thread makes them.
-pub(super) fn collapse<const W: usize>(
+/// `start`), into wide nodes appended to `out` depth-first, on the calling thread. Leaves
+/// stay triangle ranges (`{ index: first record, count }`) until [`number_tri4s`].
+fn collapse<const W: usize>(
     b: &Binary,
     refs: &mut [PrimRef],
     start: u32,
@@ -177,67 +297,22 @@ pub(super) fn collapse<const W: usize>(
     if r.is_leaf() {
         return r;
     }
-    let parallel = refs.len() >= PARALLEL_COLLAPSE;
     let (kids, len) = b.open::<W>(refs, start, r);
     let at = out.len();
     out.push(WideNode::empty());
     // The children's triangles are consecutive ranges of `refs`, in slot order.
-    let mut jobs = Vec::with_capacity(len);
     let (mut rest, mut first) = (refs, start);
-    for &(child, _) in &kids[..len] {
+    for (slot, &(child, bounds)) in kids[..len].iter().enumerate() {
         let size = b.size(child);
         let (mine, tail) = std::mem::take(&mut rest).split_at_mut(size);
         debug_assert!(!child.is_leaf() || child.index == first);
-        jobs.push((child, mine, first));
+        let r = collapse(b, mine, first, child, out);
+        out[at].set_child(slot, &bounds, r);
         rest = tail;
         first += size as u32;
     }
-    if parallel {
-        use rayon::prelude::*;
-        let parts: Vec<(ChildRef, Vec<WideNode<W>>)> = jobs
-            .into_par_iter()
-            .map(|(child, mine, first)| {
-                let mut local = Vec::new();
-                let r = collapse(b, mine, first, child, &mut local);
-                (r, local)
-            })
-            .collect();
-        for (slot, (r, local)) in parts.into_iter().enumerate() {
-            let r = append_part(out, r, local);
-            out[at].set_child(slot, &kids[slot].1, r);
-        }
-    } else {
-        for (slot, (child, mine, first)) in jobs.into_iter().enumerate() {
-            let r = collapse(b, mine, first, child, out);
-            out[at].set_child(slot, &kids[slot].1, r);
-        }
-    }
     ChildRef {
         index: at as u32,
-        count: 0,
-    }
-}
-
-/// Appends a subtree collapsed into a vector of its own (interior references local to it) to
-/// `out`, and returns the reference to its root there.
-fn append_part<const W: usize>(
-    out: &mut Vec<WideNode<W>>,
-    r: ChildRef,
-    local: Vec<WideNode<W>>,
-) -> ChildRef {
-    if r.is_leaf() {
-        return r;
-    }
-    let base = out.len() as u32;
-    out.extend(local.into_iter().map(|mut node| {
-        let used = node.children();
-        for c in node.child[..used].iter_mut().filter(|c| !c.is_leaf()) {
-            c.index += base;
-        }
-        node
-    }));
-    ChildRef {
-        index: base + r.index,
         count: 0,
     }
 }

@@ -53,7 +53,7 @@ pub(crate) use walk::STACK;
 
 use crate::build;
 use crate::node::ChildRef;
-use collapse::{Binary, collapse};
+use collapse::{Binary, collapse_tree};
 use pack::{fill_tri4s, number_tri4s};
 use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Hit, Memory, NoCount, PreparedRays, Walk,
@@ -173,16 +173,15 @@ impl<const W: usize> Accel for BvhWide<W> {
         }
         let built = build::build(&mesh, &params.binary)?;
         let (mut flat, reinsertion) = build::reinsert::optimize(built, &params.binary);
-        let mut nodes = Vec::with_capacity(flat.nodes.len() / 3 + 1);
         // The collapse leaves the leaves as triangle ranges; their `Tri4`s are numbered
         // afterwards and filled in parallel.
-        let (root, leaves) = if flat.refs.is_empty() {
-            (ChildRef::default(), Vec::new())
+        let (nodes, root, leaves) = if flat.refs.is_empty() {
+            (Vec::new(), ChildRef::default(), Vec::new())
         } else {
             let binary = Binary::new(&flat.nodes, params.fill_slots);
-            let mut root = collapse(&binary, &mut flat.refs, 0, flat.root, &mut nodes);
+            let (mut nodes, mut root) = collapse_tree(&binary, &mut flat.refs, flat.root);
             let leaves = number_tri4s(&mut nodes, &mut root);
-            (root, leaves)
+            (nodes, root, leaves)
         };
         let tri4s = fill_tri4s(&mesh, &flat.refs, &leaves);
         Ok(BvhWide {
