@@ -17,6 +17,7 @@ pub mod coherent;
 mod counters;
 mod mailbox;
 mod nearest;
+mod uncounted;
 mod walk;
 
 pub use brute::{BruteForce, BruteForceParams};

@@ -5,9 +5,7 @@ use crate::device::Device;
 use crate::error::{EmbreeError, InvalidRay};
 use crate::params::EmbreeParams;
 use crate::rays::{PreparedEmbreeRays, ValidRay, hit_of, occluded_of};
-use raybench_accel::{
-    Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit, PreparedRays,
-};
+use raybench_accel::{Accel, BuildError, BuildStats, Hit, Memory, PointHit, PreparedRays};
 use raybench_embree_sys::{self as sys, intersect_context};
 use raybench_geom::{Ray, RayError, TriangleMesh, Vec3};
 use std::ffi::c_void;
@@ -323,6 +321,9 @@ impl Accel for EmbreeScene {
         &self.name
     }
 
+    // Embree's work cannot be counted: same answers, counters untouched.
+    raybench_accel::uncounted_queries!();
+
     /// A ray `Ray::check` rejects is reported as a miss (see [`EmbreeScene::try_intersect`]).
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.try_intersect(ray).unwrap_or(None)
@@ -333,15 +334,6 @@ impl Accel for EmbreeScene {
         self.try_occluded(ray).unwrap_or(false)
     }
 
-    /// Embree's work cannot be counted: same answer, counters untouched.
-    fn intersect_counted(&self, ray: &Ray, _c: &mut Counters) -> Option<Hit> {
-        self.intersect(ray)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, _c: &mut Counters) -> bool {
-        self.occluded(ray)
-    }
-
     /// `rtcPointQuery` with a callback computing the same point–triangle distance as every
     /// other structure (see `point.rs`). A query with no answer by definition (non-finite or
     /// huge point, negative or NaN radius) returns `None` without reaching Embree.
@@ -350,20 +342,6 @@ impl Accel for EmbreeScene {
         // attached exactly `self.mesh`'s triangles in order as its only geometry (none when
         // the mesh is empty).
         unsafe { crate::point::closest_point(self.scene.0, &self.mesh, p, max_radius) }
-    }
-
-    /// Embree's work cannot be counted: same answer, counters untouched.
-    fn closest_point_counted(
-        &self,
-        p: Vec3,
-        max_radius: f32,
-        _c: &mut Counters,
-    ) -> Option<PointHit> {
-        self.closest_point(p, max_radius)
-    }
-
-    fn has_counters(&self) -> bool {
-        false
     }
 
     /// Embree does not expose its tree's shape: only timing and settings are reported.

@@ -25,8 +25,8 @@ mod imp {
     use crate::ray::CppRay;
     use crate::wald::{OwnedWald, positions};
     use crate::{CXX_MARCH, validate};
-    use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit};
-    use raybench_geom::{Ray, TriangleMesh, Vec3};
+    use raybench_accel::{Accel, BuildError, BuildStats, Hit, Memory};
+    use raybench_geom::{Ray, TriangleMesh};
     use serde::Serialize;
     use std::sync::Arc;
     use tinybvh_rs::{Intersector, bvh8_cpu, mbvh};
@@ -153,6 +153,10 @@ mod imp {
             "peer-tinybvh-bvh8"
         }
 
+        raybench_accel::uncounted_queries!();
+
+        raybench_accel::no_closest_point!();
+
         #[inline]
         fn intersect(&self, ray: &Ray) -> Option<Hit> {
             let b = self.built.as_ref()?;
@@ -167,26 +171,6 @@ mod imp {
             self.intersect(ray).is_some()
         }
 
-        fn intersect_counted(&self, ray: &Ray, _c: &mut Counters) -> Option<Hit> {
-            self.intersect(ray)
-        }
-
-        fn occluded_counted(&self, ray: &Ray, _c: &mut Counters) -> bool {
-            self.occluded(ray)
-        }
-
-        fn closest_point(&self, _p: Vec3, _max_radius: f32) -> Option<PointHit> {
-            None
-        }
-
-        fn closest_point_counted(&self, _p: Vec3, _r: f32, _c: &mut Counters) -> Option<PointHit> {
-            None
-        }
-
-        fn offers_closest_point(&self) -> bool {
-            false
-        }
-
         fn build_stats(&self) -> BuildStats {
             self.stats.clone()
         }
@@ -195,10 +179,6 @@ mod imp {
         /// leaves times BVH8_CPU's node and leaf sizes, the blocks `ConvertFrom` writes.
         fn memory(&self) -> Memory {
             self.memory
-        }
-
-        fn has_counters(&self) -> bool {
-            false
         }
     }
 }

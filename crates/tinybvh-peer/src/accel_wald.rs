@@ -11,8 +11,8 @@ use crate::build_mode::BuildMode;
 use crate::ray::CppRay;
 use crate::wald::{OwnedWald, positions};
 use crate::{CXX_MARCH, validate};
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit};
-use raybench_geom::{Ray, TriangleMesh, Vec3};
+use raybench_accel::{Accel, BuildError, BuildStats, Hit, Memory};
+use raybench_geom::{Ray, TriangleMesh};
 use serde::Serialize;
 use std::sync::Arc;
 use tinybvh_rs::Intersector;
@@ -125,6 +125,10 @@ impl Accel for TinyBvh {
         self.name
     }
 
+    raybench_accel::uncounted_queries!();
+
+    raybench_accel::no_closest_point!();
+
     #[inline]
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let wald = self.wald.as_ref()?;
@@ -137,26 +141,6 @@ impl Accel for TinyBvh {
     #[inline]
     fn occluded(&self, ray: &Ray) -> bool {
         self.intersect(ray).is_some()
-    }
-
-    fn intersect_counted(&self, ray: &Ray, _c: &mut Counters) -> Option<Hit> {
-        self.intersect(ray)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, _c: &mut Counters) -> bool {
-        self.occluded(ray)
-    }
-
-    fn closest_point(&self, _p: Vec3, _max_radius: f32) -> Option<PointHit> {
-        None
-    }
-
-    fn closest_point_counted(&self, _p: Vec3, _r: f32, _c: &mut Counters) -> Option<PointHit> {
-        None
-    }
-
-    fn offers_closest_point(&self) -> bool {
-        false
     }
 
     fn build_stats(&self) -> BuildStats {
@@ -174,9 +158,5 @@ impl Accel for TinyBvh {
             indices: (w.bvh().indices().len() * 4) as u64,
             primitives: size_of_val(w.positions()) as u64,
         }
-    }
-
-    fn has_counters(&self) -> bool {
-        false
     }
 }

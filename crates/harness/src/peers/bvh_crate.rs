@@ -14,7 +14,7 @@ use bvh::bounding_hierarchy::BHShape;
 use bvh::bvh::{Bvh, BvhNode};
 use bvh::point_query::PointDistance;
 use nalgebra::{Point3, Vector3};
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit};
+use raybench_accel::{Accel, BuildError, BuildStats, Hit, Memory, PointHit};
 use raybench_geom::{MollerTriangle, Ray, Triangle, TriangleMesh, Vec3, closest_point_on_triangle};
 use serde::Serialize;
 use std::sync::Arc;
@@ -96,6 +96,8 @@ impl Accel for BvhCrate {
         "peer-bvh"
     }
 
+    raybench_accel::uncounted_queries!();
+
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let r = Self::crate_ray(ray);
         let it = self.bvh.traverse_iterator(&r, &self.shapes).map(|s| s.prim);
@@ -108,24 +110,12 @@ impl Accel for BvhCrate {
         any_among(&self.tris, ray, it)
     }
 
-    fn intersect_counted(&self, ray: &Ray, _c: &mut Counters) -> Option<Hit> {
-        self.intersect(ray)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, _c: &mut Counters) -> bool {
-        self.occluded(ray)
-    }
-
     fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
         let found = self
             .bvh
             .nearest_to(p3(p), &self.shapes)
             .map(|(s, _)| s.prim);
         point_answer(&self.mesh, p, max_radius, found)
-    }
-
-    fn closest_point_counted(&self, p: Vec3, r: f32, _c: &mut Counters) -> Option<PointHit> {
-        self.closest_point(p, r)
     }
 
     fn build_stats(&self) -> BuildStats {
@@ -151,9 +141,5 @@ impl Accel for BvhCrate {
             indices: 0,
             primitives: (self.shapes.len() * size_of::<Shape>()) as u64,
         }
-    }
-
-    fn has_counters(&self) -> bool {
-        false
     }
 }

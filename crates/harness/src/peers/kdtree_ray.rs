@@ -11,7 +11,7 @@
 use super::{any_among, closest_among, moller_triangles};
 use cgmath::Vector3;
 use kdtree_ray::{AABB, Bounded, KDTree};
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit};
+use raybench_accel::{Accel, BuildError, BuildStats, Hit, Memory};
 use raybench_geom::{MollerTriangle, Ray, Triangle, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -64,32 +64,16 @@ impl Accel for KdtreeRay {
         "peer-kdtree-ray"
     }
 
+    raybench_accel::uncounted_queries!();
+
+    raybench_accel::no_closest_point!();
+
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         closest_among(&self.tris, ray, self.candidates(ray).into_iter())
     }
 
     fn occluded(&self, ray: &Ray) -> bool {
         any_among(&self.tris, ray, self.candidates(ray).into_iter())
-    }
-
-    fn intersect_counted(&self, ray: &Ray, _c: &mut Counters) -> Option<Hit> {
-        self.intersect(ray)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, _c: &mut Counters) -> bool {
-        self.occluded(ray)
-    }
-
-    fn closest_point(&self, _p: Vec3, _max_radius: f32) -> Option<PointHit> {
-        None
-    }
-
-    fn closest_point_counted(&self, _p: Vec3, _r: f32, _c: &mut Counters) -> Option<PointHit> {
-        None
-    }
-
-    fn offers_closest_point(&self) -> bool {
-        false
     }
 
     /// The crate keeps its nodes private: no shape figures.
@@ -104,9 +88,5 @@ impl Accel for KdtreeRay {
             primitives: (self.tris.len() * size_of::<MollerTriangle>()) as u64,
             ..Memory::default()
         }
-    }
-
-    fn has_counters(&self) -> bool {
-        false
     }
 }

@@ -13,7 +13,7 @@ use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::{CwBvh, builder::build_cwbvh_from_tris};
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit};
+use raybench_accel::{Accel, BuildError, BuildStats, Hit, Memory};
 use raybench_geom::{MollerTriangle, Ray, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -103,6 +103,10 @@ impl Accel for Obvhs {
         &self.name
     }
 
+    raybench_accel::uncounted_queries!();
+
+    raybench_accel::no_closest_point!();
+
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         let mut best: Option<Hit> = None;
@@ -134,26 +138,6 @@ impl Accel for Obvhs {
         })
     }
 
-    fn intersect_counted(&self, ray: &Ray, _c: &mut Counters) -> Option<Hit> {
-        self.intersect(ray)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, _c: &mut Counters) -> bool {
-        self.occluded(ray)
-    }
-
-    fn closest_point(&self, _p: Vec3, _max_radius: f32) -> Option<PointHit> {
-        None
-    }
-
-    fn closest_point_counted(&self, _p: Vec3, _r: f32, _c: &mut Counters) -> Option<PointHit> {
-        None
-    }
-
-    fn offers_closest_point(&self) -> bool {
-        false
-    }
-
     fn build_stats(&self) -> BuildStats {
         let Some(bvh) = &self.bvh else {
             return BuildStats::default();
@@ -179,9 +163,5 @@ impl Accel for Obvhs {
             indices: indices as u64,
             primitives: (self.tris.len() * size_of::<MollerTriangle>()) as u64,
         }
-    }
-
-    fn has_counters(&self) -> bool {
-        false
     }
 }

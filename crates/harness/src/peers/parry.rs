@@ -13,7 +13,7 @@ use super::point_answer;
 use parry3d::math::Vector;
 use parry3d::query::Ray as PRay;
 use parry3d::shape::{CompositeShapeRef, TriMesh};
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit};
+use raybench_accel::{Accel, BuildError, BuildStats, Hit, Memory, PointHit};
 use raybench_geom::{Ray, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -78,6 +78,8 @@ impl Accel for Parry {
         "peer-parry3d"
     }
 
+    raybench_accel::uncounted_queries!();
+
     fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let tm = self.trimesh.as_ref()?;
         let (r, span) = Self::crate_ray(ray);
@@ -96,14 +98,6 @@ impl Accel for Parry {
         self.intersect(ray).is_some()
     }
 
-    fn intersect_counted(&self, ray: &Ray, _c: &mut Counters) -> Option<Hit> {
-        self.intersect(ray)
-    }
-
-    fn occluded_counted(&self, ray: &Ray, _c: &mut Counters) -> bool {
-        self.occluded(ray)
-    }
-
     fn closest_point(&self, p: Vec3, max_radius: f32) -> Option<PointHit> {
         let tm = self.trimesh.as_ref()?;
         let radius = if max_radius.is_finite() {
@@ -115,10 +109,6 @@ impl Accel for Parry {
             .project_local_point_and_get_feature(pv(p), radius)
             .map(|(prim, _, _)| prim as usize);
         point_answer(&self.mesh, p, max_radius, found)
-    }
-
-    fn closest_point_counted(&self, p: Vec3, r: f32, _c: &mut Counters) -> Option<PointHit> {
-        self.closest_point(p, r)
     }
 
     fn build_stats(&self) -> BuildStats {
@@ -142,9 +132,5 @@ impl Accel for Parry {
                 .map_or(0, |t| t.total_memory_size() as u64),
             ..Memory::default()
         }
-    }
-
-    fn has_counters(&self) -> bool {
-        false
     }
 }
