@@ -2,7 +2,11 @@
 //! `bvh8-binned` and `embree-high` built in the same rounds (interleaved, medians), for choosing
 //! the knobs' defaults on a shared, noisy machine. Prints each build's median milliseconds, its
 //! ratio to embree-high's, the SAH cost, the reference growth, the spatial splits taken, and
-//! the nodes and triangle tests per closest-hit query over 20,000 random rays.
+//! the nodes and triangle tests per closest-hit query over 20,000 random rays. With
+//! `TRACE=1` in the environment it also traces 100,000 primary, random and shadow rays through
+//! every tree of the last round, one thread, in rotated order round after round (the same
+//! number of rounds), and prints per workload each tree's median time over bvh8-binned's in
+//! the same round, with nodes and triangle tests per ray: what the SAH cost does not show.
 //!
 //! `cargo run --release -p raybench-harness --example sbvh_tune -- hair 2 5 1e-5,0.5,32 1e-4,0.5,32`
 //! (scene: an .obj path or a generator spec; threads; rounds; then one
@@ -77,6 +81,9 @@ fn main() {
             work[i] = (per(c.nodes), per(c.prim_tests));
         }
     }
+    if std::env::var_os("TRACE").is_some() {
+        trace(&scene, &params, rounds);
+    }
     let high_ms = median(times[0].clone());
     println!(
         "{spec}: {} triangles, {threads} threads, {rounds} rounds",
@@ -96,5 +103,75 @@ fn main() {
             work[i].0,
             work[i].1
         );
+    }
+}
+
+/// Times primary, random and shadow rays through one tree per configuration (see the module
+/// note), on one thread, through the pass `raybench run` times.
+fn trace(scene: &raybench_scenes::Scene, params: &[(String, WideParams)], rounds: usize) {
+    use raybench_harness::pipeline::measure::{Answers, trace_pass};
+    use raybench_scenes::SurfaceHit;
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("thread pool");
+    let mesh = &scene.mesh;
+    let trees: Vec<Bvh8> = params
+        .iter()
+        .map(|(_, p)| one.install(|| Bvh8::build(Arc::clone(mesh), p).expect("builds")))
+        .collect();
+    let bounds = mesh.bounds();
+    let (primary, _, _) = raybench_scenes::primary_rays(&scene.view, &bounds, 100_000);
+    let hits: Vec<Option<SurfaceHit>> = primary
+        .iter()
+        .map(|r| {
+            trees[0].intersect(r).map(|h| SurfaceHit {
+                prim: h.prim,
+                u: h.u,
+                v: h.v,
+            })
+        })
+        .collect();
+    let shadow = raybench_scenes::shadow_rays(mesh, scene.view.light, &primary, &hits);
+    let random = raybench_scenes::random_rays(&bounds, 100_000, 1);
+    for (label, rays, any_hit) in [
+        ("primary", &primary, false),
+        ("random", &random, false),
+        ("shadow", &shadow, true),
+    ] {
+        let mut ratios = vec![Vec::new(); trees.len()];
+        let mut out = Answers::new(any_hit, rays.len());
+        let native = raybench_accel::PreparedRays::Native;
+        for t in &trees {
+            one.install(|| trace_pass(t, rays, &native, 1, &mut out));
+        }
+        for round in 0..rounds.max(3) {
+            let mut ms = vec![0.0; trees.len()];
+            for k in 0..trees.len() {
+                let i = (k + round) % trees.len();
+                let d = one.install(|| trace_pass(&trees[i], rays, &native, 1, &mut out));
+                ms[i] = d.as_secs_f64() * 1e3;
+            }
+            for i in 0..trees.len() {
+                ratios[i].push(ms[i] / ms[0]);
+            }
+        }
+        for (i, (name, _)) in params.iter().enumerate() {
+            let mut c = raybench_accel::Counters::default();
+            for ray in rays.iter() {
+                if any_hit {
+                    trees[i].occluded_counted(ray, &mut c);
+                } else {
+                    trees[i].intersect_counted(ray, &mut c);
+                }
+            }
+            let per = |x: u64| x as f64 / rays.len() as f64;
+            println!(
+                "{label:8} {name:24} time / bvh8-binned {:.3}  {:.2} nodes {:.2} tests",
+                median(ratios[i].clone()),
+                per(c.nodes),
+                per(c.prim_tests)
+            );
+        }
     }
 }
