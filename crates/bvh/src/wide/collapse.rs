@@ -209,6 +209,9 @@ impl<const W: usize> Piece<W> {
     }
 }
 
+/// Collapses the binary subtree `r`, whose triangles are `refs` (the first of them record
+/// `start`), into a [`Piece`]: on this thread below [`PARALLEL_COLLAPSE`] triangles, else with
+/// its children's subtrees on rayon.
 fn piece<const W: usize>(b: &Binary, refs: &mut [PrimRef], start: u32, r: ChildRef) -> Piece<W> {
     use rayon::prelude::*;
     if r.is_leaf() || refs.len() < PARALLEL_COLLAPSE {
@@ -224,6 +227,7 @@ fn piece<const W: usize>(b: &Binary, refs: &mut [PrimRef], start: u32, r: ChildR
         node.set_child(slot, &bounds, ChildRef::default());
         let size = b.size(child);
         let (mine, tail) = std::mem::take(&mut rest).split_at_mut(size);
+        debug_assert!(!child.is_leaf() || child.index == first);
         jobs.push((child, mine, first));
         rest = tail;
         first += size as u32;
