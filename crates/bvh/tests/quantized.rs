@@ -237,3 +237,66 @@ fn the_same_tree_with_one_and_two_threads() {
     }
     both_widths!(check);
 }
+
+/// Rays that leave the scene through its outer box (shadow rays from a roof toward the sky)
+/// end at the root, as in the float tree: the walk tests the root's children on their float
+/// boxes, where the rounded-out boxes would let every such ray into the children it starts
+/// on. The scene: a flat roof of 512 triangles at a height no power of two divides (0.7), over
+/// one small triangle on the ground, so the roof is the top face of the scene's box; rays
+/// start on the roof and go up. Checked with the counters.
+#[test]
+fn rays_leaving_the_scene_through_its_top_end_at_the_root() {
+    fn check<P: Plane>() {
+        let (n, y) = (16, 0.7);
+        let mut positions = Vec::new();
+        for i in 0..=n {
+            for j in 0..=n {
+                positions.push(Vec3::new(i as f32 / n as f32, y, j as f32 / n as f32));
+            }
+        }
+        let at = |i: u32, j: u32| i * (n + 1) + j;
+        let mut indices = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                indices.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                indices.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        let ground = positions.len() as u32;
+        positions.extend([
+            Vec3::new(0.9, 0.0, 0.9),
+            Vec3::new(0.95, 0.0, 0.9),
+            Vec3::new(0.9, 0.0, 0.95),
+        ]);
+        indices.push([ground, ground + 1, ground + 2]);
+        let mesh = raybench_testkit::mesh(positions, indices);
+        let rays: Vec<Ray> = (1..20)
+            .flat_map(|i| (1..20).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let o = Vec3::new(i as f32 / 20.0, y, j as f32 / 20.0);
+                Ray::new(o, Vec3::Y, 1e-4, f32::INFINITY)
+            })
+            .collect();
+        let q = BvhQuantized::<P>::build(mesh.clone(), &quantized::<P>()).expect("builds");
+        q.validate(&mesh).expect("valid");
+        assert!(!q.nodes().is_empty(), "a tree with interior nodes");
+        for any_hit in [false, true] {
+            let mut c = Counters::default();
+            for ray in &rays {
+                let hit = if any_hit {
+                    q.occluded_counted(ray, &mut c)
+                } else {
+                    q.intersect_counted(ray, &mut c).is_some()
+                };
+                assert!(!hit, "{ray:?} starts on the roof and leaves it");
+            }
+            assert_eq!(
+                c.nodes,
+                rays.len() as u64,
+                "one node test a ray: the root's"
+            );
+            assert_eq!(c.leaves, 0, "no leaf entered");
+        }
+    }
+    both_widths!(check);
+}

@@ -17,11 +17,14 @@
 //! rays into children the float box would have kept them out of (more nodes and leaves
 //! visited; the closest hit is the same). It can pay only when node fetches miss the caches;
 //! measured on the project machine, where the scenes' trees fit in them, both formats are
-//! slower than `bvh8-binned` (docs/experiments.md, "Compressed wide BVH"). Caveat: with 8-bit
-//! planes a child grows by up to a 255th of its node's extent per side, so a flat leaf box (a
-//! wall) gains a thickness and a ray leaving the wall enters the leaf it starts on; the child
-//! references are kept whole (8 bytes each) rather than compressed to offsets, which would
-//! need each node's children contiguous.
+//! slower than `bvh8-binned` (docs/experiments.md, "Compressed wide BVH"). The ray walk tests
+//! the root's children on a float copy of the root node: rounded out, they stick out of the
+//! scene's box, and every ray leaving the scene from its outer face (shadow rays from a roof)
+//! would walk down to the leaf it starts on. Caveats: below the root, with 8-bit planes a child
+//! grows by up to a 255th of its node's extent per side, so a flat leaf box (a wall) gains a
+//! thickness and a ray leaving the wall enters the leaf it starts on; the child references are
+//! kept whole (8 bytes each) rather than compressed to offsets, which would need each node's
+//! children contiguous.
 
 mod kernels;
 pub mod node;
@@ -29,9 +32,10 @@ mod point;
 mod validate;
 mod walk;
 
+use super::node::WideNode;
 use super::{Bvh8, NodeFormat, WideParams};
 use crate::node::ChildRef;
-use node::{Plane, QNode};
+use node::{Plane, QNode, QWIDTH};
 use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Hit, Memory, NoCount, PreparedRays, Walk,
 };
@@ -45,6 +49,9 @@ pub struct BvhQuantized<P: Plane> {
     params: WideParams,
     nodes: Vec<QNode<P>>,
     root: ChildRef,
+    /// The root node with its children's boxes in floats, which the ray walk tests instead of
+    /// the quantized root (see the module note); all empty slots when the root is a leaf.
+    root_node: WideNode<QWIDTH>,
     root_bounds: Aabb,
     tri4s: Vec<Tri4>,
     mesh: Arc<TriangleMesh>,
@@ -124,6 +131,11 @@ impl<P: Plane> Accel for BvhQuantized<P> {
             use rayon::prelude::*;
             float.nodes().par_iter().map(QNode::quantize).collect()
         };
+        // An empty mesh has no nodes and a leaf root none: all slots empty then.
+        let root_node = (!float.root.is_leaf())
+            .then(|| float.nodes().get(float.root.index as usize).copied())
+            .flatten()
+            .unwrap_or_else(WideNode::empty);
         let mut stats = float.build_stats();
         stats
             .extra
@@ -144,6 +156,7 @@ impl<P: Plane> Accel for BvhQuantized<P> {
             params: params.clone(),
             nodes,
             root,
+            root_node,
             root_bounds,
             tri4s,
             mesh,
@@ -200,7 +213,8 @@ impl<P: Plane> Accel for BvhQuantized<P> {
 
     fn memory(&self) -> Memory {
         Memory {
-            nodes: std::mem::size_of_val(self.nodes.as_slice()) as u64,
+            nodes: (std::mem::size_of_val(self.nodes.as_slice())
+                + std::mem::size_of::<WideNode<QWIDTH>>()) as u64,
             indices: 0,
             primitives: std::mem::size_of_val(self.tri4s.as_slice()) as u64,
         }

@@ -1,6 +1,7 @@
 //! The quantized tree's invariant check. Decoded boxes are not nested (each node's grid spans
 //! its own float bounds, so a grandchild's decoded box may poke out of its parent's), so the
-//! check is the one a walk relies on: every decoded child box holds every triangle below it.
+//! check is the one a walk relies on: every decoded child box holds every triangle below it,
+//! and so does every box of the float root node the ray walk tests in the root's place.
 
 use super::BvhQuantized;
 use super::node::{Plane, QNode, QWIDTH, step};
@@ -57,12 +58,25 @@ impl<P: Plane> BvhQuantized<P> {
             .ok_or("node index out of range")?;
         check_frame(node).map_err(|e| format!("node {}: {e}", r.index))?;
         let mut bounds = Aabb::default();
+        // The walk tests the root's children on the float root node instead: the same
+        // children, in the same slots, whose boxes must hold their triangles too.
+        let is_root = r == self.root;
+        if is_root
+            && (self.root_node.child != node.child || self.root_node.children() != node.children())
+        {
+            return Err("the float root node's children are not the quantized root's".into());
+        }
         for i in 0..node.children() {
             let below = self.check_subtree(mesh, node.child[i], depth + 1, covered, interior)?;
             if !node.child_bounds(i).contains_box(&below) {
                 return Err(format!(
                     "decoded box of child {i} of node {} does not hold its triangles",
                     r.index
+                ));
+            }
+            if is_root && !self.root_node.child_bounds(i).contains_box(&below) {
+                return Err(format!(
+                    "float box of child {i} of the root does not hold its triangles"
                 ));
             }
             bounds = bounds.union(&below);

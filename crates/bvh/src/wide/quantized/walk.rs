@@ -3,7 +3,8 @@
 
 use super::BvhQuantized;
 use super::kernels::QuantKernel;
-use super::node::{Plane, QNode};
+use super::node::{Plane, QWIDTH};
+use crate::node::ChildRef;
 use crate::simd::prefetch;
 use crate::wide::kernels::SseNodes;
 use crate::wide::walk::{Stack, first_in_slot_order, nearest_first, new_stack};
@@ -38,6 +39,23 @@ impl<P: Plane> BvhQuantized<P> {
         let mut best: Option<(usize, TriHit)> = None;
         let mut sp = 0;
         let mut r = self.root;
+        // The root's children are tested on their float boxes: rounded out, they would let in
+        // every ray that starts on the scene's outer box and leaves it (shadow rays from a
+        // roof toward the sky), and send it down to the leaf it starts on.
+        if !r.is_leaf() {
+            c.node();
+            let n = &self.root_node;
+            let (mask, entry) = kernel.test(&wide, n, t_min, best_t);
+            if mask == 0 {
+                return None;
+            }
+            self.prefetch_children(&n.child, mask);
+            r = if ANY_HIT {
+                first_in_slot_order(&n.child, mask, stack, &mut sp)
+            } else {
+                nearest_first(&n.child, mask, &entry, stack, &mut sp)
+            };
+        }
         'walk: loop {
             if r.is_leaf() {
                 c.leaf();
@@ -52,7 +70,7 @@ impl<P: Plane> BvhQuantized<P> {
                 let n = &self.nodes[r.index as usize];
                 let (mask, entry) = kernel.test_quantized(&wide, n, t_min, best_t);
                 if mask != 0 {
-                    self.prefetch_children(n, mask);
+                    self.prefetch_children(&n.child, mask);
                     r = if ANY_HIT {
                         first_in_slot_order(&n.child, mask, stack, &mut sp)
                     } else {
@@ -80,9 +98,9 @@ impl<P: Plane> BvhQuantized<P> {
     /// Starts fetching every child in `mask`: all of a node's lines (two or three), or a
     /// leaf's first `Tri4` (three lines).
     #[inline(always)]
-    fn prefetch_children(&self, n: &QNode<P>, mut mask: u32) {
+    fn prefetch_children(&self, child: &[ChildRef; QWIDTH], mut mask: u32) {
         while mask != 0 {
-            let r = n.child[mask.trailing_zeros() as usize];
+            let r = child[mask.trailing_zeros() as usize];
             mask &= mask - 1;
             if r.is_leaf() {
                 prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
