@@ -3,9 +3,9 @@
 //! the knobs' defaults on a shared, noisy machine. Prints each build's median milliseconds, its
 //! ratio to embree-high's, the SAH cost, the reference growth, the spatial splits taken, and
 //! the nodes and triangle tests per closest-hit query over 20,000 random rays. With
-//! `TRACE=1` in the environment it also traces 100,000 primary, random and shadow rays through
-//! every tree of the last round, one thread, in rotated order round after round (the same
-//! number of rounds), and prints per workload each tree's median time over bvh8-binned's in
+//! `TRACE=1` in the environment it also builds each configuration once more and traces
+//! 100,000 primary, random and shadow rays through every tree, one thread, in rotated order
+//! round after round (the same number of rounds, at least 3), and prints per workload each tree's median time over bvh8-binned's in
 //! the same round, with nodes and triangle tests per ray: what the SAH cost does not show.
 //!
 //! `cargo run --release -p raybench-harness --example sbvh_tune -- hair 2 5 1e-5,0.5,32 1e-4,0.5,32`
@@ -18,10 +18,8 @@ use raybench_embree::{Device, EmbreeParams, EmbreeScene};
 use std::sync::Arc;
 use std::time::Instant;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+mod probe;
+use probe::{median, primary_hits};
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -110,7 +108,6 @@ fn main() {
 /// note), on one thread, through the pass `raybench run` times.
 fn trace(scene: &raybench_scenes::Scene, params: &[(String, WideParams)], rounds: usize) {
     use raybench_harness::pipeline::measure::{Answers, trace_pass};
-    use raybench_scenes::SurfaceHit;
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -122,16 +119,7 @@ fn trace(scene: &raybench_scenes::Scene, params: &[(String, WideParams)], rounds
         .collect();
     let bounds = mesh.bounds();
     let (primary, _, _) = raybench_scenes::primary_rays(&scene.view, &bounds, 100_000);
-    let hits: Vec<Option<SurfaceHit>> = primary
-        .iter()
-        .map(|r| {
-            trees[0].intersect(r).map(|h| SurfaceHit {
-                prim: h.prim,
-                u: h.u,
-                v: h.v,
-            })
-        })
-        .collect();
+    let hits = primary_hits(&trees[0], &primary);
     let shadow = raybench_scenes::shadow_rays(mesh, scene.view.light, &primary, &hits);
     let random = raybench_scenes::random_rays(&bounds, 100_000, 1);
     for (label, rays, any_hit) in [

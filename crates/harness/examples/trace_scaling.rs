@@ -13,11 +13,11 @@ use raybench_accel::Accel;
 use raybench_harness::Registry;
 use raybench_harness::pipeline::measure::{Answers, trace_pass};
 use raybench_harness::registry::BuildContext;
-use raybench_scenes::{SurfaceHit, Workload};
+use raybench_scenes::Workload;
 use std::time::Duration;
 
 mod probe;
-use probe::median;
+use probe::{median, primary_hits};
 
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
@@ -54,16 +54,7 @@ fn main() {
             })
             .collect();
         let (primary, _, _) = raybench_scenes::primary_rays(&scene.view, &bounds, n);
-        let hits: Vec<Option<SurfaceHit>> = primary
-            .iter()
-            .map(|r| {
-                accels[0].intersect(r).map(|h| SurfaceHit {
-                    prim: h.prim,
-                    u: h.u,
-                    v: h.v,
-                })
-            })
-            .collect();
+        let hits = primary_hits(accels[0].as_ref(), &primary);
         let workloads = [
             (Workload::Primary, primary.clone()),
             (

@@ -222,15 +222,11 @@ fn piece<const W: usize>(b: &Binary, refs: &mut [PrimRef], start: u32, r: ChildR
     let (kids, len) = b.open::<W>(refs, start, r);
     let mut node = WideNode::empty();
     let mut jobs = Vec::with_capacity(len);
-    let (mut rest, mut first) = (refs, start);
-    for (slot, &(child, bounds)) in kids[..len].iter().enumerate() {
+    for (slot, (child, bounds, mine, first)) in
+        child_ranges(b, &kids[..len], refs, start).enumerate()
+    {
         node.set_child(slot, &bounds, ChildRef::default());
-        let size = b.size(child);
-        let (mine, tail) = std::mem::take(&mut rest).split_at_mut(size);
-        debug_assert!(!child.is_leaf() || child.index == first);
         jobs.push((child, mine, first));
-        rest = tail;
-        first += size as u32;
     }
     let children: Vec<Piece<W>> = jobs
         .into_par_iter()
@@ -304,19 +300,34 @@ fn collapse<const W: usize>(
     let (kids, len) = b.open::<W>(refs, start, r);
     let at = out.len();
     out.push(WideNode::empty());
-    // The children's triangles are consecutive ranges of `refs`, in slot order.
-    let (mut rest, mut first) = (refs, start);
-    for (slot, &(child, bounds)) in kids[..len].iter().enumerate() {
-        let size = b.size(child);
-        let (mine, tail) = std::mem::take(&mut rest).split_at_mut(size);
-        debug_assert!(!child.is_leaf() || child.index == first);
+    for (slot, (child, bounds, mine, first)) in
+        child_ranges(b, &kids[..len], refs, start).enumerate()
+    {
         let r = collapse(b, mine, first, child, out);
         out[at].set_child(slot, &bounds, r);
-        rest = tail;
-        first += size as u32;
     }
     ChildRef {
         index: at as u32,
         count: 0,
     }
+}
+
+/// The children of a wide node (`kids`, in slot order) with their triangles: consecutive
+/// ranges of `refs`, whose first record is `start`; each with the index of its first record.
+fn child_ranges<'a>(
+    b: &'a Binary,
+    kids: &'a [(ChildRef, Aabb)],
+    refs: &'a mut [PrimRef],
+    start: u32,
+) -> impl Iterator<Item = (ChildRef, Aabb, &'a mut [PrimRef], u32)> + 'a {
+    let (mut rest, mut first) = (refs, start);
+    kids.iter().map(move |&(child, bounds)| {
+        let size = b.size(child);
+        let (mine, tail) = std::mem::take(&mut rest).split_at_mut(size);
+        debug_assert!(!child.is_leaf() || child.index == first);
+        rest = tail;
+        let at = first;
+        first += size as u32;
+        (child, bounds, mine, at)
+    })
 }

@@ -1,5 +1,6 @@
-//! What the knob probes (`grid2tune`, `octtune`, `skiptune`; `trace_scaling` for its median)
-//! share: a scene with its seeded random and primary rays, a median, and a timed pass.
+//! What the knob probes (`grid2tune`, `octtune`, `skiptune`; `trace_scaling` and `sbvh_tune`
+//! for their median and primary hits) share: a scene with its seeded random and primary rays,
+//! the primary rays' hits, a median, and a timed pass.
 
 use raybench_accel::{Accel, Counters};
 use raybench_geom::{Ray, TriangleMesh};
@@ -15,6 +16,22 @@ pub fn scene_rays(spec: &str, n: usize) -> (Arc<TriangleMesh>, Vec<Ray>, Vec<Ray
     let random = raybench_scenes::random_rays(&mesh.bounds(), n, 1);
     let (primary, _, _) = raybench_scenes::primary_rays(&scene.view, &mesh.bounds(), n);
     (mesh, random, primary)
+}
+
+/// Where `a` finds each primary ray's closest hit: what the shadow and diffuse workloads start
+/// from.
+#[allow(dead_code)]
+pub fn primary_hits(a: &dyn Accel, primary: &[Ray]) -> Vec<Option<raybench_scenes::SurfaceHit>> {
+    primary
+        .iter()
+        .map(|r| {
+            a.intersect(r).map(|h| raybench_scenes::SurfaceHit {
+                prim: h.prim,
+                u: h.u,
+                v: h.v,
+            })
+        })
+        .collect()
 }
 
 /// The median of `v` (the upper one of an even count).

@@ -49,12 +49,7 @@ impl<P: Plane> BvhQuantized<P> {
             if mask == 0 {
                 return None;
             }
-            self.prefetch_children(&n.child, mask);
-            r = if ANY_HIT {
-                first_in_slot_order(&n.child, mask, stack, &mut sp)
-            } else {
-                nearest_first(&n.child, mask, &entry, stack, &mut sp)
-            };
+            r = self.enter::<ANY_HIT>(&n.child, mask, &entry, stack, &mut sp);
         }
         'walk: loop {
             if r.is_leaf() {
@@ -70,12 +65,7 @@ impl<P: Plane> BvhQuantized<P> {
                 let n = &self.nodes[r.index as usize];
                 let (mask, entry) = kernel.test_quantized(&wide, n, t_min, best_t);
                 if mask != 0 {
-                    self.prefetch_children(&n.child, mask);
-                    r = if ANY_HIT {
-                        first_in_slot_order(&n.child, mask, stack, &mut sp)
-                    } else {
-                        nearest_first(&n.child, mask, &entry, stack, &mut sp)
-                    };
+                    r = self.enter::<ANY_HIT>(&n.child, mask, &entry, stack, &mut sp);
                     continue 'walk;
                 }
             }
@@ -93,6 +83,26 @@ impl<P: Plane> BvhQuantized<P> {
             }
         }
         best.map(|(lane, h)| Hit::from_tri_hit(self.tri4s[lane / 4].ids[lane % 4], h))
+    }
+
+    /// Descends into the children in `mask` of a node tested: starts fetching them, pushes all
+    /// but the one to visit next (the nearest for closest hits, the first slot for any hit)
+    /// and returns that one.
+    #[inline(always)]
+    fn enter<const ANY_HIT: bool>(
+        &self,
+        child: &[ChildRef; QWIDTH],
+        mask: u32,
+        entry: &[f32; QWIDTH],
+        stack: &mut Stack,
+        sp: &mut usize,
+    ) -> ChildRef {
+        self.prefetch_children(child, mask);
+        if ANY_HIT {
+            first_in_slot_order(child, mask, stack, sp)
+        } else {
+            nearest_first(child, mask, entry, stack, sp)
+        }
     }
 
     /// Starts fetching every child in `mask`: all of a node's lines (two or three), or a
