@@ -33,6 +33,8 @@
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 mod collapse;
+#[cfg(target_arch = "x86_64")]
+mod frustum;
 mod kernels;
 mod node;
 mod pack;
