@@ -1,6 +1,8 @@
 //! The node kernels: one wide-node slab test per kernel, and the leaf test it pairs with.
 
 use super::node::{WideNode, quad};
+use super::walk::{Stack, nearest_first};
+use crate::node::ChildRef;
 use crate::simd::F4;
 use raybench_geom::{Ray, Tri4, TriHit};
 
@@ -22,6 +24,20 @@ pub(crate) trait NodeKernel<const W: usize>: Copy {
         best_t: &mut f32,
         best: &mut Option<(usize, TriHit)>,
     ) -> bool;
+
+    /// Of the children in `mask`, returns the nearest and pushes the others to pop nearest
+    /// first ([`nearest_first`]).
+    #[inline(always)]
+    fn order(
+        self,
+        child: &[ChildRef; W],
+        mask: u32,
+        entry: &[f32; W],
+        stack: &mut Stack,
+        sp: &mut usize,
+    ) -> ChildRef {
+        nearest_first(child, mask, entry, stack, sp)
+    }
 }
 
 /// The baseline kernel: one 4-lane pass per axis and four children (SSE on x86-64, portable

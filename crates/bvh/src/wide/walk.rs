@@ -135,7 +135,7 @@ impl<const W: usize> BvhWide<W> {
                     r = if ANY_HIT {
                         first_in_slot_order(&n.child, mask, stack, &mut sp)
                     } else {
-                        nearest_first(&n.child, mask, &entry, stack, &mut sp)
+                        kernel.order(&n.child, mask, &entry, stack, &mut sp)
                     };
                     continue 'walk;
                 }

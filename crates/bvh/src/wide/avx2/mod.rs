@@ -15,13 +15,16 @@
 //! AVX-512F and VL").
 
 mod leaf;
+mod order;
 
 use super::BvhWide;
 use super::kernels::{NodeKernel, slab_quads};
 use super::node::WideNode;
-use super::walk::Stack;
+use super::walk::{Stack, nearest_first};
+use crate::node::ChildRef;
 use crate::simd::F4;
 use leaf::leaf_pairs;
+use order::nearest_first_sorted;
 use raybench_accel::{CounterSink, Hit, NoCount};
 use raybench_geom::{Ray, Tri4, TriHit};
 use std::arch::x86_64::*;
@@ -139,6 +142,25 @@ impl<const W: usize> NodeKernel<W> for Avx2Nodes {
                 slab_quads(&low(&ray.origin), &low(&ray.inv), ray.near, n, t_min, t_max)
             }
         }
+    }
+
+    #[inline(always)]
+    fn order(
+        self,
+        child: &[ChildRef; W],
+        mask: u32,
+        entry: &[f32; W],
+        stack: &mut Stack,
+        sp: &mut usize,
+    ) -> ChildRef {
+        // Up to three children, the insertion is cheaper than the network's chain of stages
+        // (measured: see docs/experiments.md, "a sorting network for nodes entering four or more
+        // children").
+        if W != 8 || mask.count_ones() < 4 {
+            return nearest_first(child, mask, entry, stack, sp);
+        }
+        // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.
+        unsafe { nearest_first_sorted(child, mask, entry, stack, sp) }
     }
 
     #[inline(always)]
