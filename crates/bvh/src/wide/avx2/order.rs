@@ -4,10 +4,10 @@
 //! sorted in a bitonic network on one AVX2 register (Batcher 1968): six compare-exchange stages
 //! on eight 32-bit keys.
 //!
-//! The keys are the entry distances' bits (non-negative floats order as integers) with the slot
-//! in the low three bits, and the children not entered get the largest key. So the order is the
-//! insertion's — nearest first, equal distances lower slot first — except that distances within
-//! 8 ulps of each other also count as equal. The stack keeps each child's exact distance, so the
+//! The keys are the entry distances' bits (non-negative floats order as integers; -0 is made +0)
+//! with the slot in the low three bits, and the children not entered get the largest key. So the
+//! order is the insertion's — nearest first, equal distances lower slot first — except that
+//! distances within 8 ulps of each other also count as equal. The stack keeps each child's exact distance, so the
 //! pops skip exactly what they skip after the insertion.
 
 use crate::node::ChildRef;
@@ -56,7 +56,10 @@ pub(super) fn nearest_first_sorted<const W: usize>(
     debug_assert!(W == 8 && mask != 0 && mask < 256);
     let e: &[f32; 8] = &entry.as_chunks::<8>().0[0];
     // SAFETY: a reference to 8 initialised f32s; `loadu` has no alignment requirement.
-    let bits = unsafe { _mm256_loadu_si256(e.as_ptr().cast()) };
+    let e = unsafe { _mm256_loadu_ps(e.as_ptr()) };
+    // Adding +0 turns -0 (from a ray's `t_min` of -0) into +0, so every key is a non-negative
+    // float's bits.
+    let bits = _mm256_castps_si256(_mm256_add_ps(e, _mm256_setzero_ps()));
     let slots = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     let keys = _mm256_or_si256(_mm256_andnot_si256(_mm256_set1_epi32(7), bits), slots);
     let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
@@ -83,15 +86,16 @@ mod tests {
     use crate::wide::walk::new_stack;
 
     /// Every mask of four or more children, with distances drawn from a few values (so many
-    /// are exactly equal, and the others far more than 8 ulps apart): the network pushes the
-    /// same children with the same distances in the same order as the insertion.
+    /// are exactly equal, -0 and +0 among them, and the others far more than 8 ulps apart): the
+    /// network pushes the same children with the same distances in the same order as the
+    /// insertion.
     #[test]
     fn the_network_orders_as_the_insertion() {
         if !std::arch::is_x86_feature_detected!("avx2") {
             eprintln!("no AVX2 on this CPU: nothing to compare");
             return;
         }
-        let values = [0.0f32, 0.5, 1.0, 1.0e3, 3.25];
+        let values = [0.0f32, 0.5, -0.0, 1.0, 1.0e3, 3.25];
         let child: [ChildRef; 8] = std::array::from_fn(|i| ChildRef {
             index: 100 + i as u32,
             count: 0,
