@@ -1,5 +1,5 @@
 //! The closest-hit walk's child ordering for 8-wide nodes where a ray enters four or more
-//! children, without a branch per child: the insertion of [`nearest_first`] mispredicts on such
+//! children, without a branch per child: the insertion of `walk::nearest_first` mispredicts on such
 //! nodes, which are common where boxes overlap heavily (hair, triangle soups). The children are
 //! sorted in a bitonic network on one AVX2 register (Batcher 1968): six compare-exchange stages
 //! on eight 32-bit keys.
@@ -13,7 +13,7 @@
 use crate::node::ChildRef;
 use crate::wide::walk::Stack;
 #[cfg(test)]
-use crate::wide::walk::nearest_first;
+use crate::wide::walk::inserted;
 use std::arch::x86_64::*;
 
 /// One compare-exchange stage: lane `i` meets lane `perm[i]`, and the lanes set in `HI` keep
@@ -42,7 +42,7 @@ fn sort8(mut k: __m256i) -> __m256i {
     stage::<0b1010_1010>(k, neighbour)
 }
 
-/// [`nearest_first`] for an 8-wide node through the network: returns the nearest child in
+/// `walk::nearest_first` for an 8-wide node through the network: returns the nearest child in
 /// `mask` and pushes the others so that they pop nearest first.
 #[target_feature(enable = "avx2")]
 #[inline]
@@ -110,7 +110,7 @@ mod tests {
                     std::array::from_fn(|i| values[(i * 7 + seed * 3 + i * seed) % values.len()]);
                 let (mut a, mut b) = (new_stack(), new_stack());
                 let (mut sa, mut sb) = (0, 0);
-                let first_a = nearest_first(&child, mask, &entry, &mut a, &mut sa);
+                let first_a = inserted(&child, mask, &entry, &mut a, &mut sa);
                 // SAFETY: AVX2 was detected above.
                 let first_b =
                     unsafe { nearest_first_sorted(&child, mask, &entry, &mut b, &mut sb) };
