@@ -16,9 +16,9 @@
 //! rays (measured: see docs/experiments.md, "packet bounds before the per-ray box tests"). The
 //! trade-off, measured over the default suite's primary rays (docs/results/): 1.5–2.8× the
 //! single-ray walk on scenes of large triangles (Sponza, the teapots, Sibenik), little or less
-//! where triangles are smaller than the rays' spacing (the stadium from afar, San Francisco). Handing sparse subtrees or leaves back to the single-ray
-//! walk, as Embree's hybrid traversal does, did not measurably help (docs/experiments.md, "Packets
-//! for coherent rays").
+//! where triangles are smaller than the rays' spacing (the stadium from afar, San Francisco).
+//! Handing sparse subtrees or leaves back to the single-ray walk, as Embree's hybrid traversal
+//! does, did not measurably help (docs/experiments.md, "Packets for coherent rays").
 //!
 //! Exactness: every lane computes what the single-ray walk computes for its ray, operation for
 //! operation — the slab test with the near planes chosen by the direction's signs

@@ -153,9 +153,9 @@ impl<const W: usize> NodeKernel<W> for Avx2Nodes {
         stack: &mut Stack,
         sp: &mut usize,
     ) -> ChildRef {
-        // Up to three children, the insertion is cheaper than the network's chain of stages
-        // (measured: see docs/experiments.md, "a sorting network for nodes entering four or more
-        // children").
+        // Up to three children, the short paths of `nearest_first` are cheaper than the
+        // network's chain of stages (measured: see docs/experiments.md, "a sorting network for
+        // nodes entering four or more children").
         if W != 8 || mask.count_ones() < 4 {
             return nearest_first(child, mask, entry, stack, sp);
         }
