@@ -1,14 +1,14 @@
 //! The closest-hit walk's child ordering for 8-wide nodes where a ray enters four or more
-//! children, without a branch per child: the insertion of `walk::nearest_first` mispredicts on such
-//! nodes, which are common where boxes overlap heavily (hair, triangle soups). The children are
-//! sorted in a bitonic network on one AVX2 register (Batcher 1968): six compare-exchange stages
-//! on eight 32-bit keys.
+//! children, without a branch per child: the insertion of `walk::nearest_first` mispredicts on
+//! such nodes, which are common where boxes overlap heavily (hair, triangle soups). The children
+//! are sorted in a bitonic network on one AVX2 register (Batcher 1968): six compare-exchange
+//! stages on eight 32-bit keys.
 //!
 //! The keys are the entry distances' bits (non-negative floats order as integers; -0 is made +0)
 //! with the slot in the low three bits, and the children not entered get the largest key. So the
 //! order is the insertion's — nearest first, equal distances lower slot first — except that
-//! distances within 8 ulps of each other also count as equal. The stack keeps each child's exact distance, so the
-//! pops skip exactly what they skip after the insertion.
+//! distances within 8 ulps of each other also count as equal. The stack keeps each child's exact
+//! distance, so the pops skip exactly what they skip after the insertion.
 
 use crate::node::ChildRef;
 use crate::wide::walk::Stack;
