@@ -28,8 +28,8 @@ pub(super) struct Frustum {
     inv_hi: [__m256; 3],
     /// The smallest `t_min`.
     t_min: __m256,
-    /// Per axis, which stored side (min or max) holds the near planes.
-    near: [usize; 3],
+    /// Per axis, which stored side (min or max) holds the near planes (the walk's, too).
+    pub(super) near: [usize; 3],
 }
 
 impl Frustum {

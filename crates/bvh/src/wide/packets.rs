@@ -107,8 +107,8 @@ fn walk<const W: usize>(
     best: &mut Best,
     stack: &mut PacketStack,
 ) {
-    let near = [0, 1, 2].map(|a| (octant >> a & 1) as usize);
     let frustum = Frustum::new(p, active, octant);
+    let near = frustum.near;
     let mut farthest = _mm512_mask_reduce_max_ps(active, best.t);
     let mut sp = 0;
     let mut r = bvh.root();
@@ -228,9 +228,9 @@ fn walk_any<const W: usize>(
     best: &mut Best,
     stack: &mut PacketStack,
 ) -> u16 {
-    let near = [0, 1, 2].map(|a| (octant >> a & 1) as usize);
     let t_max = best.t;
     let frustum = Frustum::new(p, active, octant);
+    let near = frustum.near;
     let farthest = _mm512_mask_reduce_max_ps(active, t_max);
     let none = _mm512_set1_epi32(NO_PRIM as i32);
     let mut live = active;
