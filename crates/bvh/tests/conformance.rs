@@ -1,6 +1,6 @@
 //! The shared conformance suite for every BVH variant, `validate()` after every build.
 
-use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, BvhWide, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, BvhWide, Collapse, WideParams};
 use raybench_testkit::conformance;
 
 fn check(params: BvhParams) {
@@ -55,16 +55,27 @@ fn binned_conforms_on_the_shared_scenes() {
     eprintln!("real scenes checked: {checked}");
 }
 
-/// The defaults and, with tiny leaves, deep binary trees collapsed into full wide nodes.
-fn wide_params(width: u32) -> [WideParams; 2] {
-    let tiny = WideParams {
+/// The defaults, the greedy collapse and, with tiny leaves, deep binary trees collapsed into
+/// full wide nodes by each collapse.
+fn wide_params(width: u32) -> [WideParams; 4] {
+    let greedy = WideParams {
+        collapse: Collapse::Greedy,
+        ..WideParams::for_width(width)
+    };
+    let tiny = |collapse| WideParams {
         binary: BvhParams {
             max_leaf_size: 1,
             ..BvhParams::binned()
         },
+        collapse,
         ..WideParams::for_width(width)
     };
-    [WideParams::for_width(width), tiny]
+    [
+        WideParams::for_width(width),
+        greedy,
+        tiny(Collapse::Optimal),
+        tiny(Collapse::Greedy),
+    ]
 }
 
 /// The shared suite on a `W`-wide tree, both parameter sets.

@@ -21,7 +21,7 @@
 //! after its build) are still spinning when the next build starts.
 
 use raybench_accel::Accel;
-use raybench_bvh::{Bvh, Bvh8, BvhParams, WideParams};
+use raybench_bvh::{Bvh, Bvh8, BvhParams, Collapse, WideParams};
 use raybench_embree::{Device, EmbreeParams, EmbreeScene};
 use std::sync::Arc;
 use std::time::Instant;
@@ -80,6 +80,10 @@ fn main() {
     let _device = Device::shared(&embree.config_string()).expect("Embree device");
     let binned = BvhParams::binned();
     let wide = WideParams::default();
+    let greedy = WideParams {
+        collapse: Collapse::Greedy,
+        ..WideParams::default()
+    };
     let bin4 = wide.binary.clone();
 
     type Build<'a> = Box<dyn Fn() -> Box<dyn Accel> + Sync + 'a>;
@@ -99,6 +103,10 @@ fn main() {
         (
             "bvh8",
             Box::new(|| Box::new(Bvh8::build(Arc::clone(&mesh), &wide).expect("builds"))),
+        ),
+        (
+            "bvh8-greedy",
+            Box::new(|| Box::new(Bvh8::build(Arc::clone(&mesh), &greedy).expect("builds"))),
         ),
     ];
     let structures: Vec<_> = structures

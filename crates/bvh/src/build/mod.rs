@@ -36,6 +36,7 @@ use prim::{MAX_PRIMS, Ranged};
 use raybench_accel::{BuildError, BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use raybench_geom::{Aabb, TriangleMesh};
 use rayon::prelude::*;
+pub(crate) use split::blocks;
 use split::{
     PARALLEL_BINNING, Scratch, Split, binned_split, leaf_beats_any_split, median_split, sweep_split,
 };

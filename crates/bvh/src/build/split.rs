@@ -54,7 +54,7 @@ pub(crate) fn split_cost(
 /// The triangle tests a leaf of `n` costs: `n` rounded up to whole blocks of `leaf_block`
 /// (a mask for the usual power of two: the binned sweep calls this six times a boundary).
 #[inline(always)]
-fn blocks(p: &BvhParams, n: usize) -> f64 {
+pub(crate) fn blocks(p: &BvhParams, n: usize) -> f64 {
     let block = p.leaf_block.max(1) as usize;
     if block.is_power_of_two() {
         ((n + block - 1) & !(block - 1)) as f64

@@ -1,17 +1,21 @@
 //! The binary tree collapsed into wide nodes.
 
 use super::node::WideNode;
+use super::optimal::Plan;
+use crate::BvhParams;
 use crate::build::{Box3, PrimRef};
 use crate::node::{ChildRef, Node};
 use raybench_geom::Aabb;
 
 /// What every collapse task reads: the binary tree, the number of triangles under each of its
-/// interior nodes (a subtree's triangles are one range of the builder's records), and whether
-/// empty slots are filled.
+/// interior nodes (a subtree's triangles are one range of the builder's records), whether
+/// empty slots are filled, and the SAH-optimal plan of every node's children (none for the
+/// greedy collapse).
 pub(super) struct Binary<'a> {
     nodes: &'a [Node],
     sizes: Vec<u32>,
     fill_slots: bool,
+    plan: Option<Plan>,
 }
 
 /// Leaves of more triangles than this (one `Tri4`) may be split to fill a node's empty slots.
@@ -22,7 +26,13 @@ const SPLIT_LEAVES_ABOVE: u32 = 4;
 const PARALLEL_COLLAPSE: usize = 4096;
 
 impl Binary<'_> {
-    pub(super) fn new(nodes: &[Node], fill_slots: bool) -> Binary<'_> {
+    /// `optimal`: the width and the builder's prices to plan the children with (see
+    /// `optimal.rs`), or `None` for the greedy collapse.
+    pub(super) fn new<'a>(
+        nodes: &'a [Node],
+        fill_slots: bool,
+        optimal: Option<(usize, &BvhParams)>,
+    ) -> Binary<'a> {
         let mut sizes = vec![0u32; nodes.len()];
         // Children follow their parent in the depth-first array: fill in sizes bottom-up.
         for i in (0..nodes.len()).rev() {
@@ -38,10 +48,12 @@ impl Binary<'_> {
                 })
                 .sum();
         }
+        let plan = optimal.map(|(width, p)| Plan::new(nodes, width, p));
         Binary {
             nodes,
             sizes,
             fill_slots,
+            plan,
         }
     }
 
@@ -54,10 +66,11 @@ impl Binary<'_> {
     }
 
     /// The children of the wide node made from binary node `r`, whose triangles are `refs`
-    /// (the first of them record `start`): starting from its two children, the interior child
-    /// with the largest area is opened (first on ties: deterministic) until there are `W` or
-    /// only leaves remain; slots still empty are filled by splitting the largest leaves of more
-    /// than one `Tri4`. Children stay in the order of their triangles.
+    /// (the first of them record `start`): the plan's, when there is one; otherwise, starting
+    /// from its two children, the interior child with the largest area is opened (first on
+    /// ties: deterministic) until there are `W` or only leaves remain. Slots still empty are
+    /// filled by splitting the largest leaves of more than one `Tri4`. Children stay in the
+    /// order of their triangles.
     fn open<const W: usize>(
         &self,
         refs: &mut [PrimRef],
@@ -67,9 +80,15 @@ impl Binary<'_> {
         let n = &self.nodes[r.index as usize];
         // A fixed array, not a Vec: one wide node per call, no allocation.
         let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
-        kids[0] = (n.child[0], n.child_bounds(0));
-        kids[1] = (n.child[1], n.child_bounds(1));
         let mut len = 2;
+        let planned = if let Some(plan) = &self.plan {
+            (kids, len) = plan.children::<W>(self.nodes, r);
+            true
+        } else {
+            kids[0] = (n.child[0], n.child_bounds(0));
+            kids[1] = (n.child[1], n.child_bounds(1));
+            false
+        };
         let largest = |kids: &[(ChildRef, Aabb)], openable: &dyn Fn(ChildRef) -> bool| {
             (0..kids.len())
                 .filter(|&i| openable(kids[i].0))
@@ -82,7 +101,7 @@ impl Binary<'_> {
                 })
         };
         while len < W {
-            let two = if let Some(i) = largest(&kids[..len], &|c| !c.is_leaf()) {
+            let two = if let Some(i) = largest(&kids[..len], &|c| !planned && !c.is_leaf()) {
                 let m = &self.nodes[kids[i].0.index as usize];
                 let halves = [
                     (m.child[0], m.child_bounds(0)),

@@ -2,12 +2,14 @@
 //! tree, traversed with one SIMD box test per node (see docs/results/ for where they stand
 //! against Embree).
 //!
-//! Collapse (`collapse.rs`; as in Wald et al. 2008, "Getting rid of packets", and Embree's
-//! BVH4/BVH8 builders): each wide node starts from a binary node's two children and repeatedly
-//! opens the child with the largest surface area — the one a ray is most likely to enter —
-//! until it has `W` children or only leaves remain; slots still empty are then filled by
-//! splitting the largest leaves of more than one `Tri4` in two (`fill_slots`, as Embree's
-//! builder splits every child until the node is full). The wide tree has about a third (8
+//! Collapse (`collapse.rs`): by default each wide node's children are chosen for the least SAH
+//! cost of the whole wide tree, by dynamic programming over the binary tree (`optimal.rs`,
+//! [`Collapse::Optimal`], as in Ylitie, Karras and Laine 2017); the greedy collapse of Wald et
+//! al. 2008 ("Getting rid of packets") and Embree's BVH4/BVH8 builders ([`Collapse::Greedy`])
+//! starts from a binary node's two children and repeatedly opens the child with the largest
+//! surface area until it has `W` children or only leaves remain. Either way, slots still empty
+//! are then filled by splitting the largest leaves of more than one `Tri4` in two
+//! (`fill_slots`, as Embree's builder splits every child until the node is full). The wide tree has about a third (8
 //! wide) or half (4 wide) of the binary tree's depth, so a ray walks fewer, wider nodes: fewer
 //! dependent memory fetches. The trade-off between the widths: a 4-wide node is two cache
 //! lines and one 4-lane SSE test per axis, an 8-wide node four lines and one 8-lane AVX2 test,
@@ -37,6 +39,7 @@ mod collapse;
 mod frustum;
 mod kernels;
 mod node;
+mod optimal;
 mod pack;
 #[cfg(target_arch = "x86_64")]
 mod packets;
@@ -47,7 +50,7 @@ mod validate;
 mod walk;
 
 pub use node::WideNode;
-pub use params::{NodeFormat, NodeSimd, WideParams};
+pub use params::{Collapse, NodeFormat, NodeSimd, WideParams};
 pub use quantized::{Bvh8Compressed, Bvh8Compressed16, BvhQuantized, node::Plane, node::QNode};
 
 pub(crate) use node::quad;
@@ -180,7 +183,12 @@ impl<const W: usize> Accel for BvhWide<W> {
         let (nodes, root, leaves) = if flat.refs.is_empty() {
             (Vec::new(), ChildRef::default(), Vec::new())
         } else {
-            let binary = Binary::new(&flat.nodes, params.fill_slots);
+            let optimal = params.collapse == Collapse::Optimal;
+            let binary = Binary::new(
+                &flat.nodes,
+                params.fill_slots,
+                optimal.then_some((W, &params.binary)),
+            );
             let (mut nodes, mut root) = collapse_tree(&binary, &mut flat.refs, flat.root);
             let leaves = number_tri4s(&mut nodes, &mut root);
             (nodes, root, leaves)

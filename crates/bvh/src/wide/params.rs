@@ -35,6 +35,18 @@ pub enum NodeFormat {
     Quantized16,
 }
 
+/// How the binary tree's nodes are grouped into wide nodes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Collapse {
+    /// Each wide node opens its largest child until it is full (`collapse.rs`).
+    Greedy,
+    /// Each wide node's children chosen for the least SAH cost of the whole wide tree, by
+    /// dynamic programming over the binary tree (`optimal.rs`).
+    #[default]
+    Optimal,
+}
+
 /// Knobs of a wide BVH: the binary tree it is collapsed from, the node width and the node
 /// test.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -46,6 +58,8 @@ pub struct WideParams {
     /// The kernels: with AVX2, 8-wide nodes take one 8-lane pass per axis (4-wide ones keep
     /// one 4-lane pass) and leaves are tested two `Tri4`s a pass.
     pub node_simd: NodeSimd,
+    /// How binary nodes are grouped into wide nodes.
+    pub collapse: Collapse,
     /// Split leaves of more than one `Tri4` into the slots a node would leave empty (see
     /// `collapse.rs`); off, the wide tree has exactly the binary tree's leaves.
     pub fill_slots: bool,
@@ -98,6 +112,8 @@ impl Default for WideParams {
             },
             width: MAX_WIDTH as u32,
             node_simd: NodeSimd::Auto,
+            // Measured: see docs/experiments.md, "SAH-optimal collapse".
+            collapse: Collapse::Optimal,
             fill_slots: true,
             coherent_packets: false,
             node_format: NodeFormat::Float,

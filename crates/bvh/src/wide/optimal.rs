@@ -1,0 +1,378 @@
+//! The children of every wide node chosen for the least SAH cost, by dynamic programming over
+//! the binary tree (the collapse of Ylitie, Karras and Laine 2017, "Efficient incoherent ray
+//! traversal on GPUs through compressed wide BVHs", section 3, without its leaf merging).
+//!
+//! The greedy collapse (`collapse.rs`) opens a node's largest child until the node is full,
+//! so every wide node takes as many children as it can, and the deeper ones are left with
+//! what remains: a binary subtree of five leaves under a full node becomes a node of five
+//! children where two slots above could have held it whole. Here every binary interior node
+//! `n` gets, for each `i` from 1 to `W`, the least cost of covering its triangles with at most
+//! `i` children of one wide node: `n` alone (a leaf of the binary tree, or a wide node whose
+//! `W` slots cover its two children), or `k` children covering its left child and `i - k` its
+//! right. A wide node made from `n` takes the cheapest split of its `W` slots between its
+//! two children. The prices are the binary builder's, so the two agree on what a tree costs:
+//! a node test is the traversal cost times the node's box area, a leaf the intersection cost
+//! times its area times its triangles rounded up to whole blocks.
+//!
+//! Making leaves of whole binary subtrees (the rest of Ylitie et al.'s collapse) never
+//! changed a tree on the 17 scenes of the suite, and pricing the split of a leaf into two
+//! slots inside the table built more slowly for the same speed (measured: see
+//! docs/experiments.md, "SAH-optimal collapse"); the greedy collapse's leaf splits still
+//! fill any slot the chosen children leave empty.
+//!
+//! One pass over the binary nodes, children before parents, with at most `W²/2` sums each;
+//! subtrees of [`PARALLEL_PLAN`] nodes or more are planned on rayon, and the plan does not
+//! depend on the thread count.
+
+use super::MAX_WIDTH;
+use crate::BvhParams;
+use crate::build::blocks;
+use crate::node::{ChildRef, Node};
+use raybench_geom::Aabb;
+
+/// Subtrees of at least this many binary nodes plan their two children on rayon.
+const PARALLEL_PLAN: usize = 8192;
+
+/// One binary interior node's entry: for `i` = 1 to `W`, the least cost of covering it with
+/// at most `i` children (`cost[i - 1]`) and how (`cover[i - 1]`: `(0, 0)` the node alone, or
+/// at most that many children from each of its two); and how its own wide node splits its
+/// `W` slots between its children.
+#[derive(Clone, Copy)]
+struct Entry {
+    cost: [f32; MAX_WIDTH],
+    cover: [(u8, u8); MAX_WIDTH],
+    own: (u8, u8),
+}
+
+const EMPTY: Entry = Entry {
+    cost: [0.0; MAX_WIDTH],
+    cover: [(0, 0); MAX_WIDTH],
+    own: (0, 0),
+};
+
+/// The entries of every binary interior node, in the binary tree's order.
+pub(super) struct Plan {
+    entries: Vec<Entry>,
+}
+
+impl Plan {
+    /// The plan for `width`-wide nodes over the binary tree `nodes` (depth-first from the
+    /// root at index 0: a node's left subtree right after it, then its right subtree).
+    pub(super) fn new(nodes: &[Node], width: usize, p: &BvhParams) -> Plan {
+        let mut entries = vec![EMPTY; nodes.len()];
+        if !nodes.is_empty() {
+            plan(nodes, 0, &mut entries, width, p);
+        }
+        Plan { entries }
+    }
+
+    /// The children of the wide node made from binary interior node `r`, in the order of
+    /// their triangles: binary interior nodes (each a wide node in turn) and leaves.
+    pub(super) fn children<const W: usize>(
+        &self,
+        nodes: &[Node],
+        r: ChildRef,
+    ) -> ([(ChildRef, Aabb); W], usize) {
+        let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
+        let mut len = 0;
+        let (a, b) = self.entries[r.index as usize].own;
+        let node = &nodes[r.index as usize];
+        for (c, budget) in [(0, a), (1, b)] {
+            let child = (node.child[c], node.child_bounds(c));
+            self.cover(nodes, child, budget, &mut kids, &mut len);
+        }
+        (kids, len)
+    }
+
+    fn cover<const W: usize>(
+        &self,
+        nodes: &[Node],
+        (r, bounds): (ChildRef, Aabb),
+        budget: u8,
+        kids: &mut [(ChildRef, Aabb); W],
+        len: &mut usize,
+    ) {
+        let (a, b) = if r.is_leaf() {
+            (0, 0)
+        } else {
+            self.entries[r.index as usize].cover[budget as usize - 1]
+        };
+        if a == 0 {
+            kids[*len] = (r, bounds);
+            *len += 1;
+            return;
+        }
+        let node = &nodes[r.index as usize];
+        for (c, budget) in [(0, a), (1, b)] {
+            self.cover(
+                nodes,
+                (node.child[c], node.child_bounds(c)),
+                budget,
+                kids,
+                len,
+            );
+        }
+    }
+
+    /// The least cost of the wide tree made from binary interior node `r` (its own node
+    /// test included), in the builder's prices, not divided by the root's area.
+    #[cfg(test)]
+    pub(super) fn cost_as_node(&self, r: ChildRef) -> f32 {
+        self.entries[r.index as usize].cost[0]
+    }
+}
+
+/// Fills the entries of the subtree of binary interior node `at`: `entries` is exactly that
+/// subtree's range of the binary tree, so `entries[0]` is `at`'s entry.
+fn plan(nodes: &[Node], at: usize, entries: &mut [Entry], width: usize, p: &BvhParams) {
+    let node = &nodes[at];
+    // A child's subtree starts at its index; the left one right after `at`.
+    let (left, right) = (node.child[0], node.child[1]);
+    let right_offset = if right.is_leaf() {
+        entries.len()
+    } else {
+        right.index as usize - at
+    };
+    {
+        let (left_part, right_part) = entries[1..].split_at_mut(right_offset - 1);
+        let big = left_part.len().min(right_part.len()) >= PARALLEL_PLAN;
+        let go_left = |part: &mut [Entry]| {
+            if !left.is_leaf() {
+                plan(nodes, left.index as usize, part, width, p);
+            }
+        };
+        let go_right = |part: &mut [Entry]| {
+            if !right.is_leaf() {
+                plan(nodes, right.index as usize, part, width, p);
+            }
+        };
+        if big {
+            rayon::join(|| go_left(left_part), || go_right(right_part));
+        } else {
+            go_left(left_part);
+            go_right(right_part);
+        }
+    }
+    let side = |c: usize| -> [f32; MAX_WIDTH] {
+        let r = node.child[c];
+        if r.is_leaf() {
+            [leaf_cost(half_area(&node.child_bounds(c)), r.count, p); MAX_WIDTH]
+        } else {
+            entries[r.index as usize - at].cost
+        }
+    };
+    let (l, r) = (side(0), side(1));
+    // The cheapest split of `j` slots between the two children, j = 2 ..= width.
+    let mut split = [(f32::INFINITY, (0u8, 0u8)); MAX_WIDTH + 1];
+    for (j, s) in split.iter_mut().enumerate().take(width + 1).skip(2) {
+        for k in 1..j {
+            let c = l[k - 1] + r[j - k - 1];
+            if c < s.0 {
+                *s = (c, (k as u8, (j - k) as u8));
+            }
+        }
+    }
+    let area = half_area(&node.child_bounds(0).union(&node.child_bounds(1)));
+    let e = &mut entries[0];
+    e.own = split[width].1;
+    let mut best = (area * p.traversal_cost + split[width].0, (0, 0));
+    for i in 1..=width {
+        if i >= 2 && split[i].0 < best.0 {
+            best = split[i];
+        }
+        e.cost[i - 1] = best.0;
+        e.cover[i - 1] = best.1;
+    }
+}
+
+fn leaf_cost(area: f32, n: u32, p: &BvhParams) -> f32 {
+    area * p.intersection_cost * blocks(p, n as usize) as f32
+}
+
+/// Half the surface area (only ratios of areas matter); zero for an empty box.
+fn half_area(b: &Aabb) -> f32 {
+    let e = (b.max - b.min).max(raybench_geom::Vec3::ZERO);
+    e.x * e.y + e.y * e.z + e.z * e.x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::build::{Flat, build};
+    use crate::wide::{BvhWide, Collapse, WideParams};
+    use raybench_accel::Accel;
+
+    fn binary(spec: &str, p: &BvhParams) -> Flat {
+        let mesh = raybench_testkit::generated(spec, 3);
+        build(&mesh, p).expect("builds")
+    }
+
+    /// The cheapest way of covering `r` with exactly `k` children, for every `k` up to
+    /// `budget` (`f64::INFINITY` where there is none): `r` itself, or a cover of each of its
+    /// children. By recursion over the tree, without the table or its ranges.
+    fn covers(nodes: &[Node], r: ChildRef, bounds: Aabb, budget: usize, p: &BvhParams) -> Vec<f64> {
+        let mut best = vec![f64::INFINITY; budget + 1];
+        best[1] = cheapest_as_child(nodes, r, bounds, p);
+        if !r.is_leaf() && budget >= 2 {
+            let n = &nodes[r.index as usize];
+            let a = covers(nodes, n.child[0], n.child_bounds(0), budget - 1, p);
+            let b = covers(nodes, n.child[1], n.child_bounds(1), budget - 1, p);
+            for (ka, ca) in a.iter().enumerate().skip(1) {
+                for (kb, cb) in b.iter().enumerate().skip(1).take(budget - ka) {
+                    best[ka + kb] = best[ka + kb].min(ca + cb);
+                }
+            }
+        }
+        best
+    }
+
+    /// The least cost of `r` as one child: its leaf, or its cheapest wide node.
+    fn cheapest_as_child(nodes: &[Node], r: ChildRef, bounds: Aabb, p: &BvhParams) -> f64 {
+        if r.is_leaf() {
+            return leaf_cost(half_area(&bounds), r.count, p) as f64;
+        }
+        cheapest_node(nodes, r, p)
+    }
+
+    fn cheapest_node(nodes: &[Node], r: ChildRef, p: &BvhParams) -> f64 {
+        let n = &nodes[r.index as usize];
+        let area = half_area(&n.child_bounds(0).union(&n.child_bounds(1))) as f64;
+        let a = covers(nodes, n.child[0], n.child_bounds(0), MAX_WIDTH - 1, p);
+        let b = covers(nodes, n.child[1], n.child_bounds(1), MAX_WIDTH - 1, p);
+        let mut best = f64::INFINITY;
+        for (ka, ca) in a.iter().enumerate().skip(1) {
+            for cb in b.iter().skip(1).take(MAX_WIDTH - ka) {
+                best = best.min(ca + cb);
+            }
+        }
+        area * p.traversal_cost as f64 + best
+    }
+
+    /// The cost of a built wide tree in the builder's prices, summed in f64.
+    fn wide_cost<const W: usize>(t: &BvhWide<W>, p: &BvhParams) -> f64 {
+        let mut sum = 0.0;
+        let root = &t.nodes()[t.root().index as usize];
+        let whole = (0..root.children()).fold(Aabb::EMPTY, |b, i| b.union(&root.child_bounds(i)));
+        sum += half_area(&whole) as f64 * p.traversal_cost as f64;
+        let mut stack = vec![t.root()];
+        while let Some(r) = stack.pop() {
+            let n = &t.nodes()[r.index as usize];
+            for i in 0..n.children() {
+                let (c, area) = (n.child[i], half_area(&n.child_bounds(i)) as f64);
+                if c.is_leaf() {
+                    sum += area * (p.intersection_cost * blocks(p, c.count as usize) as f32) as f64;
+                } else {
+                    sum += area * p.traversal_cost as f64;
+                    stack.push(c);
+                }
+            }
+        }
+        sum
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-4 * a.abs().max(b.abs())
+    }
+
+    /// On small trees (single-triangle leaves, so deep), the table's cost of every interior
+    /// node is the least over every cover an exhaustive enumeration finds.
+    #[test]
+    fn the_plan_is_the_cheapest_of_every_cover() {
+        let p = BvhParams {
+            max_leaf_size: 1,
+            ..WideParams::default().binary
+        };
+        for spec in [
+            "soup:triangles=40",
+            "teapot:triangles=48",
+            "grass:density=1",
+        ] {
+            let flat = binary(spec, &p);
+            assert!(flat.nodes.len() > 20, "{spec}: {} nodes", flat.nodes.len());
+            let plan = Plan::new(&flat.nodes, MAX_WIDTH, &p);
+            for i in 0..flat.nodes.len().min(60) {
+                let r = ChildRef {
+                    index: i as u32,
+                    count: 0,
+                };
+                let (planned, exhaustive) = (
+                    plan.cost_as_node(r) as f64,
+                    cheapest_node(&flat.nodes, r, &p),
+                );
+                assert!(
+                    close(planned, exhaustive),
+                    "{spec} node {i}: {planned} against {exhaustive}"
+                );
+            }
+        }
+    }
+
+    /// Without leaf splits, the wide tree built from the plan costs what the plan says, and
+    /// no more than the greedy collapse's tree of the same binary tree.
+    #[test]
+    fn the_built_tree_costs_what_the_plan_says() {
+        fn check<const W: usize>(spec: &str) {
+            let mesh = raybench_testkit::generated(spec, 3);
+            let with = |collapse| WideParams {
+                collapse,
+                fill_slots: false,
+                ..WideParams::for_width(W as u32)
+            };
+            let optimal =
+                BvhWide::<W>::build(mesh.clone(), &with(Collapse::Optimal)).expect("builds");
+            let greedy =
+                BvhWide::<W>::build(mesh.clone(), &with(Collapse::Greedy)).expect("builds");
+            optimal.validate(&mesh).expect("the tree validates");
+            let p = &optimal.params().binary;
+            let flat = build(&mesh, p).expect("builds");
+            let planned = Plan::new(&flat.nodes, W, p).cost_as_node(flat.root) as f64;
+            let (built, greedy) = (wide_cost(&optimal, p), wide_cost(&greedy, p));
+            assert!(
+                close(planned, built),
+                "{spec}, {W} wide: planned {planned}, built {built}"
+            );
+            assert!(
+                built <= greedy * (1.0 + 1e-6),
+                "{spec}, {W} wide: {built} against greedy {greedy}"
+            );
+            assert_eq!(optimal.build_stats().refs, mesh.len() as u64);
+        }
+        for spec in [
+            "teapot:triangles=20000",
+            "soup:triangles=5000",
+            "grass:density=20",
+            "hair",
+        ] {
+            check::<8>(spec);
+            check::<4>(spec);
+        }
+    }
+
+    /// Large subtrees are planned on rayon; the plan is the one a single thread makes.
+    #[test]
+    fn the_plan_is_the_same_on_one_and_two_threads() {
+        let p = WideParams::default().binary;
+        let flat = binary("sphere:triangles=200000", &p);
+        let n = &flat.nodes[0];
+        assert!(n.child.iter().all(|c| !c.is_leaf()));
+        assert!(
+            flat.nodes[0].child[1].index as usize - 1 >= PARALLEL_PLAN,
+            "big enough to fork"
+        );
+        let plan = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            pool.install(|| Plan::new(&flat.nodes, MAX_WIDTH, &p))
+        };
+        let (one, two) = (plan(1), plan(2));
+        let bits = |plan: &Plan| -> Vec<(Vec<u32>, Vec<(u8, u8)>, (u8, u8))> {
+            plan.entries
+                .iter()
+                .map(|e| (e.cost.map(f32::to_bits).to_vec(), e.cover.to_vec(), e.own))
+                .collect()
+        };
+        assert!(bits(&one) == bits(&two));
+    }
+}
