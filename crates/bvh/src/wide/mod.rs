@@ -2,18 +2,18 @@
 //! tree, traversed with one SIMD box test per node (see docs/results/ for where they stand
 //! against Embree).
 //!
-//! Collapse (`collapse.rs`): by default each wide node's children are chosen for the least SAH
-//! cost of the whole wide tree, by dynamic programming over the binary tree (`optimal.rs`,
-//! [`Collapse::Optimal`], as in Ylitie, Karras and Laine 2017); the greedy collapse of Wald et
-//! al. 2008 ("Getting rid of packets") and Embree's BVH4/BVH8 builders ([`Collapse::Greedy`])
-//! starts from a binary node's two children and repeatedly opens the child with the largest
-//! surface area until it has `W` children or only leaves remain. Either way, slots still empty
-//! are then filled by splitting the largest leaves of more than one `Tri4` in two
-//! (`fill_slots`, as Embree's builder splits every child until the node is full). The wide tree has about a third (8
-//! wide) or half (4 wide) of the binary tree's depth, so a ray walks fewer, wider nodes: fewer
-//! dependent memory fetches. The trade-off between the widths: a 4-wide node is two cache
-//! lines and one 4-lane SSE test per axis, an 8-wide node four lines and one 8-lane AVX2 test,
-//! and fewer of them on a ray's path.
+//! Collapse (`collapse.rs`): by default each wide node's children are chosen for the least SAH cost
+//! of the whole wide tree, by dynamic programming over the binary tree (`optimal.rs`,
+//! [`Collapse::Optimal`], as in Ylitie, Karras and Laine 2017); the greedy collapse of Wald et al.
+//! 2008 ("Getting rid of packets") and Embree's BVH4/BVH8 builders ([`Collapse::Greedy`]) starts
+//! from a binary node's two children and repeatedly opens the child with the largest surface area
+//! until it has `W` children or only leaves remain. Either way, slots still empty are then filled
+//! by splitting the largest leaves of more than one `Tri4` in two (`fill_slots`, as Embree's
+//! builder splits every child until the node is full). The wide tree has about a third (8 wide) or
+//! half (4 wide) of the binary tree's depth, so a ray walks fewer, wider nodes: fewer dependent
+//! memory fetches. The trade-off between the widths: a 4-wide node is two cache lines and one
+//! 4-lane SSE test per axis, an 8-wide node four lines and one 8-lane AVX2 test, and fewer of them
+//! on a ray's path.
 //!
 //! Traversal (`walk.rs`) is ordered: the children a ray enters are sorted by entry distance,
 //! the farther ones pushed with that distance and skipped when popped beyond the closest hit.
