@@ -79,16 +79,17 @@ impl Binary<'_> {
     ) -> ([(ChildRef, Aabb); W], usize) {
         let n = &self.nodes[r.index as usize];
         // A fixed array, not a Vec: one wide node per call, no allocation.
-        let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
-        let mut len = 2;
-        let planned = if let Some(plan) = &self.plan {
-            (kids, len) = plan.children::<W>(self.nodes, r);
-            true
-        } else {
-            kids[0] = (n.child[0], n.child_bounds(0));
-            kids[1] = (n.child[1], n.child_bounds(1));
-            false
+        let (mut kids, mut len) = match &self.plan {
+            Some(plan) => plan.children::<W>(self.nodes, r),
+            None => {
+                let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
+                kids[0] = (n.child[0], n.child_bounds(0));
+                kids[1] = (n.child[1], n.child_bounds(1));
+                (kids, 2)
+            }
         };
+        // The plan's children are final; only the greedy collapse opens more of them.
+        let planned = self.plan.is_some();
         let largest = |kids: &[(ChildRef, Aabb)], openable: &dyn Fn(ChildRef) -> bool| {
             (0..kids.len())
                 .filter(|&i| openable(kids[i].0))
