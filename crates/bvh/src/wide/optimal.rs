@@ -39,7 +39,7 @@ const PARALLEL_PLAN: usize = 8192;
 /// `W` slots between its children.
 #[derive(Clone, Copy)]
 struct Entry {
-    cost: [f32; MAX_WIDTH],
+    cost: [f64; MAX_WIDTH],
     cover: [(u8, u8); MAX_WIDTH],
     own: (u8, u8),
 }
@@ -117,7 +117,7 @@ impl Plan {
     /// The least cost of the wide tree made from binary interior node `r` (its own node
     /// test included), in the builder's prices, not divided by the root's area.
     #[cfg(test)]
-    pub(super) fn cost_as_node(&self, r: ChildRef) -> f32 {
+    pub(super) fn cost_as_node(&self, r: ChildRef) -> f64 {
         self.entries[r.index as usize].cost[0]
     }
 }
@@ -153,29 +153,34 @@ fn plan(nodes: &[Node], at: usize, entries: &mut [Entry], width: usize, p: &BvhP
             go_right(right_part);
         }
     }
-    let side = |c: usize| -> [f32; MAX_WIDTH] {
+    let side = |c: usize| -> [f64; MAX_WIDTH] {
         let r = node.child[c];
         if r.is_leaf() {
-            [leaf_cost(half_area(&node.child_bounds(c)), r.count, p); MAX_WIDTH]
+            [leaf_cost(node.child_bounds(c).surface_area(), r.count, p); MAX_WIDTH]
         } else {
             entries[r.index as usize - at].cost
         }
     };
     let (l, r) = (side(0), side(1));
     // The cheapest split of `j` slots between the two children, j = 2 ..= width.
-    let mut split = [(f32::INFINITY, (0u8, 0u8)); MAX_WIDTH + 1];
+    // Starting from one slot on the left, so every split names both children's slots.
+    let mut split = [(0.0, (0u8, 0u8)); MAX_WIDTH + 1];
     for (j, s) in split.iter_mut().enumerate().take(width + 1).skip(2) {
-        for k in 1..j {
+        *s = (l[0] + r[j - 2], (1, (j - 1) as u8));
+        for k in 2..j {
             let c = l[k - 1] + r[j - k - 1];
             if c < s.0 {
                 *s = (c, (k as u8, (j - k) as u8));
             }
         }
     }
-    let area = half_area(&node.child_bounds(0).union(&node.child_bounds(1)));
+    let area = node
+        .child_bounds(0)
+        .union(&node.child_bounds(1))
+        .surface_area();
     let e = &mut entries[0];
     e.own = split[width].1;
-    let mut best = (area * p.traversal_cost + split[width].0, (0, 0));
+    let mut best = (area * p.traversal_cost as f64 + split[width].0, (0, 0));
     for (i, s) in split.iter().enumerate().take(width + 1).skip(1) {
         if i >= 2 && s.0 < best.0 {
             best = *s;
@@ -185,14 +190,8 @@ fn plan(nodes: &[Node], at: usize, entries: &mut [Entry], width: usize, p: &BvhP
     }
 }
 
-fn leaf_cost(area: f32, n: u32, p: &BvhParams) -> f32 {
-    area * p.intersection_cost * blocks(p, n as usize) as f32
-}
-
-/// Half the surface area (only ratios of areas matter); zero for an empty box.
-fn half_area(b: &Aabb) -> f32 {
-    let e = (b.max - b.min).max(raybench_geom::Vec3::ZERO);
-    e.x * e.y + e.y * e.z + e.z * e.x
+fn leaf_cost(area: f64, n: u32, p: &BvhParams) -> f64 {
+    area * p.intersection_cost as f64 * blocks(p, n as usize)
 }
 
 #[cfg(test)]
@@ -229,14 +228,14 @@ mod tests {
     /// The least cost of `r` as one child: its leaf, or its cheapest wide node.
     fn cheapest_as_child(nodes: &[Node], r: ChildRef, bounds: Aabb, p: &BvhParams) -> f64 {
         if r.is_leaf() {
-            return leaf_cost(half_area(&bounds), r.count, p) as f64;
+            return leaf_cost(bounds.surface_area(), r.count, p);
         }
         cheapest_node(nodes, r, p)
     }
 
     fn cheapest_node(nodes: &[Node], r: ChildRef, p: &BvhParams) -> f64 {
         let n = &nodes[r.index as usize];
-        let area = half_area(&n.child_bounds(0).union(&n.child_bounds(1))) as f64;
+        let area = n.child_bounds(0).union(&n.child_bounds(1)).surface_area();
         let a = covers(nodes, n.child[0], n.child_bounds(0), MAX_WIDTH - 1, p);
         let b = covers(nodes, n.child[1], n.child_bounds(1), MAX_WIDTH - 1, p);
         let mut best = f64::INFINITY;
@@ -253,14 +252,14 @@ mod tests {
         let mut sum = 0.0;
         let root = &t.nodes()[t.root().index as usize];
         let whole = (0..root.children()).fold(Aabb::EMPTY, |b, i| b.union(&root.child_bounds(i)));
-        sum += half_area(&whole) as f64 * p.traversal_cost as f64;
+        sum += whole.surface_area() * p.traversal_cost as f64;
         let mut stack = vec![t.root()];
         while let Some(r) = stack.pop() {
             let n = &t.nodes()[r.index as usize];
             for i in 0..n.children() {
-                let (c, area) = (n.child[i], half_area(&n.child_bounds(i)) as f64);
+                let (c, area) = (n.child[i], n.child_bounds(i).surface_area());
                 if c.is_leaf() {
-                    sum += area * (p.intersection_cost * blocks(p, c.count as usize) as f32) as f64;
+                    sum += leaf_cost(area, c.count, p);
                 } else {
                     sum += area * p.traversal_cost as f64;
                     stack.push(c);
@@ -295,10 +294,8 @@ mod tests {
                     index: i as u32,
                     count: 0,
                 };
-                let (planned, exhaustive) = (
-                    plan.cost_as_node(r) as f64,
-                    cheapest_node(&flat.nodes, r, &p),
-                );
+                let (planned, exhaustive) =
+                    (plan.cost_as_node(r), cheapest_node(&flat.nodes, r, &p));
                 assert!(
                     close(planned, exhaustive),
                     "{spec} node {i}: {planned} against {exhaustive}"
@@ -325,7 +322,7 @@ mod tests {
             optimal.validate(&mesh).expect("the tree validates");
             let p = &optimal.params().binary;
             let flat = build(&mesh, p).expect("builds");
-            let planned = Plan::new(&flat.nodes, W, p).cost_as_node(flat.root) as f64;
+            let planned = Plan::new(&flat.nodes, W, p).cost_as_node(flat.root);
             let (built, greedy) = (wide_cost(&optimal, p), wide_cost(&greedy, p));
             assert!(
                 close(planned, built),
@@ -374,8 +371,33 @@ mod tests {
         let (one, two) = (plan(1), plan(2));
         assert_eq!(one.entries.len(), two.entries.len());
         for (a, b) in one.entries.iter().zip(&two.entries) {
-            assert_eq!(a.cost.map(f32::to_bits), b.cost.map(f32::to_bits));
+            assert_eq!(a.cost.map(f64::to_bits), b.cost.map(f64::to_bits));
             assert_eq!((a.cover, a.own), (b.cover, b.own));
         }
+    }
+
+    /// Boxes near Embree's coordinate limit (1.844e18) have areas near f32's largest, so the
+    /// plan sums its costs in f64: summed in f32 they overflowed, no split was cheaper than
+    /// infinity, and the collapse indexed a cover of zero slots.
+    #[test]
+    fn boxes_near_the_coordinate_limit_are_planned() {
+        use raybench_geom::{Triangle, TriangleMesh, Vec3};
+        let big = 1.8e18f32;
+        let tris: Vec<Triangle> = (0..400)
+            .map(|i| {
+                let t = i as f32 / 400.0;
+                Triangle::new(
+                    Vec3::new(-big, -big * t, -big),
+                    Vec3::new(big, big * (1.0 - t), -big * t),
+                    Vec3::new(big * t, big, big),
+                )
+            })
+            .collect();
+        let (mesh, removed) = TriangleMesh::from_triangles(&tris).expect("a mesh");
+        assert_eq!(removed, Default::default());
+        let mesh = std::sync::Arc::new(mesh);
+        let t = BvhWide::<8>::build(mesh.clone(), &WideParams::default()).expect("builds");
+        t.validate(&mesh).expect("the tree validates");
+        assert!(t.nodes().len() > 1, "{} nodes", t.nodes().len());
     }
 }
