@@ -5,7 +5,7 @@
 //! joined once; the result is a depth-first array of 64-byte nodes (each holding both
 //! children's boxes, laid out for one SIMD slab test per axis) with the triangles reordered into
 //! leaf order, and traversed
-//! from that flat form ([`traverse`]). Five registered variants share the code:
+//! from that flat form (`traverse`). Five registered variants share the code:
 //!
 //! | name | builder | traversal |
 //! |---|---|---|
@@ -193,7 +193,7 @@ impl Bvh {
         &self.params
     }
 
-    /// Checks the invariants (see [`validate`]).
+    /// Checks the invariants (see `validate`).
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         validate::validate(self, mesh)
     }

@@ -10,7 +10,7 @@ use raybench_geom::TriangleMesh;
 /// With spatial splits a triangle may be in several leaves (never twice in one), and each of
 /// those leaves' boxes may hold only part of it: then every triangle must be in some leaf, and
 /// the boxes of the leaves holding it must overlap its box and together cover it
-/// ([`cover::check_references`]).
+/// ([`cover::check_references`](crate::cover::check_references)).
 pub(crate) fn validate(bvh: &Bvh, mesh: &TriangleMesh) -> Result<(), String> {
     let n = mesh.len();
     let spatial = bvh.params.spatial_splits.is_some();

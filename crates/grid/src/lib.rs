@@ -7,7 +7,7 @@
 //! one entry per cell (plus one) into one reference array, built by a counting sort
 //! ([`build`]). Rays walk the cells they pierce in order with the 3D-DDA of Amanatides and Woo
 //! (1987), test each triangle once thanks to a small on-stack mailbox, and stop in the first
-//! cell whose exit lies beyond the closest hit ([`traverse`]). Closest-point queries visit the
+//! cell whose exit lies beyond the closest hit (`traverse`). Closest-point queries visit the
 //! cells in expanding shells around the point's cell and stop when the next shell is farther
 //! than the nearest triangle found (`points.rs`).
 //!
@@ -164,7 +164,7 @@ impl Grid {
         self.triangles[i as usize / LANES].ids[i as usize % LANES]
     }
 
-    /// Checks the invariants (see [`validate`]).
+    /// Checks the invariants (see `validate`).
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         validate::validate(self, mesh)
     }

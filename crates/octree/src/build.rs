@@ -67,7 +67,7 @@ struct Ctx<'a> {
     nodes: AtomicU64,
     /// Bytes that do not grow: triangle copies and per-triangle bounds.
     fixed_bytes: u64,
-    /// Nodes at this depth are leaves ([`depth_limit`]).
+    /// Nodes at this depth are leaves ([`adaptive_depth_limit`]).
     depth_limit: u32,
 }
 

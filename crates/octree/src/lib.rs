@@ -11,7 +11,7 @@
 //! back — at each node the ray's crossings of the three centre planes, sorted, give the
 //! children in the order the ray enters them — and stop at the first leaf whose exit lies at
 //! or beyond the closest hit, testing each triangle once thanks to a small mailbox
-//! ([`traverse`]). Closest-point queries descend nearest octant first and skip every octant
+//! (`traverse`). Closest-point queries descend nearest octant first and skip every octant
 //! farther than the nearest triangle found so far (`points.rs`).
 //!
 //! Against the uniform grid: the octree adapts its cell size to where the triangles are, so a
@@ -129,7 +129,7 @@ impl Octree {
         self.root_box
     }
 
-    /// Checks the invariants (see [`validate`]).
+    /// Checks the invariants (see `validate`).
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         validate::validate(self, mesh)
     }

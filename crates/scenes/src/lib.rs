@@ -1,6 +1,6 @@
 //! raybench-scenes: the scenes and rays every structure is measured on.
 //!
-//! * Scenes: procedural generators ([`generate`], listed by [`generators`]) and Wavefront OBJ
+//! * Scenes: procedural generators ([`fn@generate`], listed by [`generators`]) and Wavefront OBJ
 //!   files ([`load_obj`]), both behind [`resolve`]. OBJ files are untrusted input: every problem
 //!   is a [`SceneError`] naming the file (and line), never a panic.
 //! * Workloads ([`Workload`]): primary, random, shadow, diffuse and Whitted rays, and

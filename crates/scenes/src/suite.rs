@@ -24,7 +24,7 @@ pub struct Suite {
     pub points: Option<usize>,
 }
 
-/// A scene of a suite: a [`generate`] spec, or an OBJ file.
+/// A scene of a suite: a [`generate`](fn@crate::generate) spec, or an OBJ file.
 #[derive(Deserialize, Serialize, Clone, Debug, PartialEq)]
 #[serde(untagged)]
 pub enum SuiteScene {

@@ -83,7 +83,7 @@ pub(crate) fn wald_stats(wald: &OwnedWald) -> BuildStats {
 }
 
 impl TinyBvh {
-    /// The structure's invariants: those of the Wald BVH (see [`validate::wald`]).
+    /// The structure's invariants: those of the Wald BVH (see `validate::wald`).
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         let Some(w) = &self.wald else {
             return match mesh.len() {

@@ -1,13 +1,13 @@
-//! BVH construction over one array of 32-byte primitive records ([`prim::PrimRef`]: a
+//! BVH construction over one array of 32-byte primitive records (`prim::PrimRef`: a
 //! triangle's box and its mesh index) that every node reorders in place, each node owning a
 //! contiguous range.
 //!
-//! Three ways to choose a split, each a function in [`split`] with its own note:
+//! Three ways to choose a split, each a function in `split` with its own note:
 //! * `median_split` — object median on the longest centroid axis;
 //! * `sweep_split` — full-sweep SAH;
 //! * `binned_split` — binned SAH.
 //!
-//! Termination and degenerate input are handled once, in [`decide`]: a range of one triangle,
+//! Termination and degenerate input are handled once, in `decide`: a range of one triangle,
 //! at [`MAX_DEPTH`], or so small that its leaf costs no more than one node step (no split can
 //! then be cheaper), is a leaf; a split function returns `None` when it finds no way (or no
 //! profitable way) to separate the centroids, and then a range that fits in a leaf becomes
@@ -15,8 +15,8 @@
 //! so recursion always shrinks the range and always ends.
 //!
 //! Shape of the build: ranges above `parallel_threshold` are split on two rayon tasks
-//! ([`Part::Split`]); each range at or below it is built sequentially straight into its own
-//! depth-first node vector ([`Part::Local`]), all its nodes sharing one [`split::Scratch`].
+//! (`Part::Split`); each range at or below it is built sequentially straight into its own
+//! depth-first node vector (`Part::Local`), all its nodes sharing one `split::Scratch`.
 //! Flattening then copies every node exactly once, relocating child indices — no node is boxed or
 //! allocated on its own.
 

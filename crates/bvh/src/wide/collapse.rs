@@ -307,6 +307,8 @@ fn place<const W: usize>(piece: Piece<W>, out: &mut [WideNode<W>], base: u32) ->
 /// Collapses the binary subtree `r`, whose triangles are `refs` (the first of them record
 /// `start`), into wide nodes appended to `out` depth-first, on the calling thread. Leaves
 /// stay triangle ranges (`{ index: first record, count }`) until [`number_tri4s`].
+///
+/// [`number_tri4s`]: super::pack::number_tri4s
 fn collapse<const W: usize>(
     b: &Binary,
     refs: &mut [PrimRef],

@@ -10,7 +10,7 @@ impl<const W: usize> BvhWide<W> {
     /// triangle; every mesh triangle exactly once; depth within the stack bound. With spatial
     /// splits a triangle may be in several leaves (never twice in one) whose boxes each hold
     /// part of it: they must overlap its box and together cover it
-    /// ([`check_references`](crate::cover::check_references)).
+    /// (`check_references`).
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         let n = mesh.len();
         check_lanes(

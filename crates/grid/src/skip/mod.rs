@@ -9,7 +9,7 @@
 //!   occupancy bit. A non-empty cell is tested as in `grid`. In an empty cell with
 //!   `k >= min_jump`, every cell within `k − 1` cells of it is empty, so the walk jumps to the
 //!   state it would reach by stepping to where the ray leaves that block of (2k−1)³ cells
-//!   (clipped to the grid), computed from the f32 cell planes ([`crate::dda::Dda::jump`]).
+//!   (clipped to the grid), computed from the f32 cell planes (`crate::dda::Dda::jump`).
 //!   The jump is exact: the walk then visits the same non-empty cells in the same order as
 //!   `grid`, so hits, triangle tests and mailbox skips are `grid`'s bit for bit; only the empty
 //!   cells stepped (`cells`) drop, and each jump is counted (`jumps`). A jump must move the ray
@@ -97,7 +97,7 @@ impl SkipGrid {
         self.distance[self.grid.layout.index([x, y, z])]
     }
 
-    /// Checks the grid's invariants and the distance field's (see [`validate`]).
+    /// Checks the grid's invariants and the distance field's (see `validate`).
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         self.grid.validate(mesh)?;
         validate::validate(self)

@@ -180,7 +180,7 @@ impl Grid2 {
         self.grids.len()
     }
 
-    /// Checks the invariants (see [`validate`]).
+    /// Checks the invariants (see `validate`).
     pub fn validate(&self, mesh: &TriangleMesh) -> Result<(), String> {
         validate::validate(self, mesh)
     }

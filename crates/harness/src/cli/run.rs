@@ -1,5 +1,8 @@
 //! `raybench run`: build, time, count and check every structure; write report.json and draw it.
 
+// The doc comments are clap help text, where `<date>` is a placeholder, not HTML.
+#![allow(rustdoc::invalid_html_tags)]
+
 use super::report::print_rendered;
 use super::{DEFAULT_POINTS, Defaults, Selection, claim_outputs, exit_status};
 use crate::outdir;

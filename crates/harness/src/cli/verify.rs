@@ -1,5 +1,8 @@
 //! `raybench verify`: check answers, not speed, against three references; write verify.json.
 
+// The doc comments are clap help text, where `<date>` is a placeholder, not HTML.
+#![allow(rustdoc::invalid_html_tags)]
+
 use super::{DEFAULT_POINTS, Defaults, Selection, budget, claim_outputs, exit_status};
 use crate::outdir;
 use crate::output::verify_table::verify_table;

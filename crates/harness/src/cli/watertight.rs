@@ -1,5 +1,8 @@
 //! `raybench watertight`: crack hunting; write watertight.json and print the miss rates.
 
+// The doc comments are clap help text, where `<date>` is a placeholder, not HTML.
+#![allow(rustdoc::invalid_html_tags)]
+
 use super::{at_least_one, budget, exit_status, pick};
 use crate::output::watertight_table::watertight_table;
 use crate::pipeline::verify::BRUTE_FORCE_BUDGET;

@@ -4,7 +4,7 @@
 //! machine a slow spell then lands on every structure alike instead of on whichever one was
 //! being timed, and each round's ratio to the reference compares passes run moments apart.
 //! Every timed pass is kept (the report's `samples`); the ratio to the reference is the median
-//! of the per-round ratios, with a confidence interval ([`super::interval`]).
+//! of the per-round ratios, with a confidence interval ([`crate::report::interval`]).
 //!
 //! The price is memory: all of a scene's structures (and their prepared rays) are alive
 //! together, where measuring one after the other held one at a time.
@@ -25,7 +25,7 @@ pub(super) struct Pending<'e> {
     pub entry: &'e StructureEntry,
     /// The warm-up build: the one every pass traces.
     pub built: Built,
-    /// Everything but the timings, which [`finish`] fills in.
+    /// Everything but the timings, which [`finish`](Pending::finish) fills in.
     pub result: ResultEntry,
     pub jobs: Vec<Job>,
     build_ms: Vec<f64>,

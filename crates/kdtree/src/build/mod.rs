@@ -11,7 +11,7 @@
 //! on the split axis, and a flat root cell is never split on its flat axis), the depth is
 //! capped ([`KdParams::max_depth`], at most [`MAX_DEPTH`]; past the default limit only cells of
 //! more than [`LARGE_LEAF`] triangles are cut, while a plane separates them), and each subtree holds at most its
-//! [`Share`] of the references the memory limit allows, so neither recursion nor memory can
+//! `Share` of the references the memory limit allows, so neither recursion nor memory can
 //! grow without bound, whatever the input (huge triangles spanning the scene, thousands of
 //! triangles in one plane or at one point). Within those guards the SAH builder stops where
 //! its cost model says a leaf is cheaper than any split, which already charges a split for
@@ -161,7 +161,7 @@ pub(crate) struct Shape {
     /// Leaves over [`LARGE_LEAF`] triangles: all of them, and those whose bounds share a point.
     large: u64,
     large_piles: u64,
-    /// Σ area(cell)/area(root) × cost, see [`Out::leaf`] and [`Out::interior`].
+    /// Σ area(cell)/area(root) × cost, see [`Out::leaf`] and [`Out::open_interior`].
     sah: f64,
 }
 
@@ -184,7 +184,7 @@ impl Shape {
 
 /// A depth-first subtree being written: an interior node is followed by its subtree below the
 /// plane, then the one above; leaves point into `refs` (mesh triangle ids until
-/// [`finish`] renumbers them).
+/// [`pack::pack`] renumbers them).
 #[derive(Debug, Default)]
 pub(crate) struct Out {
     pub nodes: Vec<Node>,

@@ -1,7 +1,7 @@
 //! Split BVH (SBVH; Stich, Friedrich and Dietrich 2009, "Spatial Splits in Bounding Volume
 //! Hierarchies"): at each node the binned object split is weighed against a spatial split, a
 //! plane that cuts the triangles crossing it into one reference per side, each with the box of
-//! its piece ([`bins`], [`divide`]). Where long or diagonal triangles make the object split's
+//! its piece ([`bins`], [`mod@divide`]). Where long or diagonal triangles make the object split's
 //! children overlap, cutting them shrinks the boxes a ray must enter, at the price of more
 //! references (a triangle may be tested twice on a ray) and a slower build. Two limits keep
 //! the price down: a spatial split is only tried where the object split's children overlap by

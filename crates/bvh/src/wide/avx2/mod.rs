@@ -9,7 +9,7 @@
 //! adds no arithmetic an 8-lane f32 test needs, so there is no AVX-512 kernel. What it adds is
 //! registers: 32 vector registers instead of 16. The walk keeps ten splatted values of the ray live
 //! (origin, direction, inverse direction, `t_min`); with AVX2's sixteen, the compiler spills them
-//! and reloads six at every node. The batch loops are therefore compiled twice ([`batch_loops`]),
+//! and reloads six at every node. The batch loops are therefore compiled twice (`batch_loops`),
 //! once with AVX-512F and VL enabled; the same arithmetic runs in both, so the answers and counters
 //! are the same (measured: see docs/experiments.md, "batch loops compiled a second time with
 //! AVX-512F and VL").

@@ -1,5 +1,5 @@
 //! SVG charts drawn with plotters. Text is emitted as SVG `<text>` (plotters' naive font, and
-//! the [`Overlay`]'s own), so no font files are read at build or run time. Two shapes cover
+//! the `Overlay`'s own), so no font files are read at build or run time. Two shapes cover
 //! every chart: grouped bars (groups on x, one bar per series), here, and lines
 //! ([`super::lines`]). Both keep their legend in a column right of the plot and draw the
 //! fastest and slowest timed run as an error bar where the report has them.

@@ -62,6 +62,8 @@ pub(super) fn parse_corner(token: &str) -> Result<[Option<i64>; 3], String> {
 /// Resolves a 1-based or negative (relative) OBJ index to a 0-based one, as tobj does: negative
 /// indices count back from the elements seen so far, positive ones may refer forward (checked
 /// here against the whole file, and by [`State::close_model`] against its object).
+///
+/// [`State::close_model`]: super::State::close_model
 pub(super) fn resolve(
     index: i64,
     so_far: usize,
