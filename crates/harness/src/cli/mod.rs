@@ -33,9 +33,7 @@ use std::process::ExitCode;
 pub const DEFAULT_POINTS: usize = 10_000;
 
 /// A count that must be at least 1: `--rays 0` or `--threads abc` is refused by clap as
-/// "invalid value '0' for '--rays <RAYS>': must be a whole number of at least 1".
-// The doc quotes clap's error message, where `<RAYS>` is a placeholder, not HTML.
-#[allow(rustdoc::invalid_html_tags)]
+/// `invalid value '0' for '--rays <RAYS>': must be a whole number of at least 1`.
 pub(crate) fn at_least_one(text: &str) -> Result<usize, String> {
     match text.trim().parse::<usize>() {
         Ok(n) if n >= 1 => Ok(n),
