@@ -500,3 +500,71 @@ fn the_geometric_mean_gates_and_one_scene_alone_is_advisory() {
     assert!(c.findings.iter().any(|f| f.severity == Severity::Regression
         && f.what.starts_with("soup-again / bvh-binned / primary")));
 }
+
+/// Embree's single-ray presets against the Embree reference are the machine's figures, not
+/// raybench's: their slowdowns are advisory. An Embree entry that batches rays in raybench's
+/// wrapper (a stream) and raybench's own entries stay gated.
+#[test]
+fn embree_against_embree_is_advisory_and_the_batched_entries_stay_gated() {
+    let narrow = |x: f64| Interval {
+        lo: x * 0.99,
+        hi: x * 1.01,
+        level: 0.9375,
+    };
+    let mut old = base().clone();
+    let template = bvh(&mut old).clone();
+    for (name, params) in [
+        (
+            "embree-robust",
+            serde_json::json!({"quality": "medium", "robust": true}),
+        ),
+        (
+            "embree-medium-stream",
+            serde_json::json!({"quality": "medium", "coherent_stream": true}),
+        ),
+    ] {
+        let mut e = template.clone();
+        e.structure = name.into();
+        e.params = params;
+        old.results.push(e);
+    }
+    for e in &mut old.results {
+        let s = e.workloads[0].speedup_vs_reference.unwrap();
+        e.workloads[0].speedup_interval = Some(narrow(s));
+    }
+    let mut new = old.clone();
+    for e in new
+        .results
+        .iter_mut()
+        .filter(|e| e.structure != "embree-medium")
+    {
+        let w = &mut e.workloads[0];
+        let s = w.speedup_vs_reference.unwrap() / 1.2; // 20 % slower
+        w.speedup_vs_reference = Some(s);
+        w.speedup_interval = Some(narrow(s));
+    }
+    let strict = CompareOptions {
+        max_scene_slowdown: 0.10,
+        ..CompareOptions::default()
+    };
+    let c = compare(&old, &new, &strict);
+    let of = |name: &str, severity: Severity| {
+        c.findings
+            .iter()
+            .any(|f| f.severity == severity && f.at.contains(&format!("/ {name} /")))
+    };
+    assert!(of("embree-robust", Severity::Advisory), "{}", text(&c));
+    assert!(!of("embree-robust", Severity::Regression), "{}", text(&c));
+    assert!(
+        text(&c).contains("Embree against Embree, not gated"),
+        "{}",
+        text(&c)
+    );
+    assert!(
+        of("embree-medium-stream", Severity::Regression),
+        "{}",
+        text(&c)
+    );
+    assert!(of("bvh-binned", Severity::Regression), "{}", text(&c));
+    assert!(of("bruteforce", Severity::Regression), "{}", text(&c));
+}

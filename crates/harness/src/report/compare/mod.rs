@@ -21,7 +21,9 @@
 //!   `report/interval.rs`) a slowdown must be significant: the most favourable end of its
 //!   interval still beyond the threshold, with intervals of at least [`MIN_LEVEL`] coverage
 //!   (three builds give 75 %: their changes are advisory). Reports without samples fall back
-//!   to the medians alone, as a point test. Timing fails unless advisory.
+//!   to the medians alone, as a point test. Timing fails unless advisory. A ratio of Embree
+//!   against Embree, a single-ray preset against the reference, is always advisory (see
+//!   `timing::embree_against_itself`).
 //!
 //! Entries in the base that the new report lacks fail too (a structure that stopped building is
 //! not "no regression"), unless the comparison is of a subset (`subset`): then they are "not
@@ -34,7 +36,7 @@ pub use timing::{Change, MIN_LEVEL};
 use super::run::{Report, ResultEntry, WorkloadResult, is_point_workload, throughput_unit};
 use crate::output::compare_table::{Row, row};
 use std::collections::BTreeMap;
-use timing::{compare_geomeans, timing_finding};
+use timing::{compare_geomeans, embree_against_itself, timing_finding};
 
 /// How to judge timing ratios.
 #[derive(Clone, Copy, Debug)]
@@ -204,20 +206,18 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
                 );
                 continue;
             };
-            let is_reference = key.1 == new.run.reference;
+            let ratio = if key.1 == new.run.reference {
+                Ratio::OfReference
+            } else if embree_against_itself(&key.1, &be.params, &new.run.reference) {
+                Ratio::EmbreeOnly
+            } else {
+                Ratio::Gated
+            };
             // Query points, like primary and random rays, depend on the scene and seed only.
             let independent_rays =
                 matches!(bw.workload.as_str(), "primary" | "random") || bw.point_query;
             let gate_counters = comparable && (same_embree || independent_rays);
-            compare_workload(
-                &label,
-                bw,
-                nw,
-                gate_counters,
-                is_reference,
-                opts,
-                &mut findings,
-            );
+            compare_workload(&label, bw, nw, gate_counters, ratio, opts, &mut findings);
             rows.push(row(be, ne, bw, nw, comparable, opts));
         }
     }
@@ -408,6 +408,7 @@ fn compare_build_time(
             "build time ratio",
             &change,
             opts.max_scene_slowdown,
+            embree_against_itself(&b.structure, &b.params, &reference_name(b)),
             opts,
             findings,
         );
@@ -421,12 +422,23 @@ fn reference_name(e: &ResultEntry) -> String {
         .unwrap_or_default()
 }
 
+/// How a workload's throughput ratio to the reference is judged.
+#[derive(Clone, Copy, PartialEq)]
+enum Ratio {
+    /// The reference itself (always 1): not judged.
+    OfReference,
+    /// Embree against Embree ([`embree_against_itself`]): advisory.
+    EmbreeOnly,
+    /// Gated by the thresholds.
+    Gated,
+}
+
 fn compare_workload(
     label: &str,
     b: &WorkloadResult,
     n: &WorkloadResult,
     gate_counters: bool,
-    is_reference: bool,
+    ratio: Ratio,
     opts: &CompareOptions,
     findings: &mut Vec<Finding>,
 ) {
@@ -450,7 +462,7 @@ fn compare_workload(
         });
     }
     if let (Some(x), Some(y)) = (b.speedup_vs_reference, n.speedup_vs_reference)
-        && !is_reference
+        && ratio != Ratio::OfReference
         && y > 0.0
     {
         let change = Change::new((x, b.speedup_interval), (y, n.speedup_interval), true);
@@ -460,6 +472,7 @@ fn compare_workload(
             &what,
             &change,
             opts.max_scene_slowdown,
+            ratio == Ratio::EmbreeOnly,
             opts,
             findings,
         );
