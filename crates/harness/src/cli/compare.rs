@@ -57,6 +57,11 @@ pub struct CompareArgs {
     /// Also write every row as a Markdown table to this file.
     #[arg(long)]
     full_table: Option<PathBuf>,
+    /// When every regression is a timing slowdown, write the structures they concern to this
+    /// file, comma-separated, for a second timing of just those (scripts/ci-gate); otherwise
+    /// remove the file, so that no list from an earlier comparison is left behind.
+    #[arg(long, value_name = "FILE")]
+    timing_regressions_to: Option<PathBuf>,
 }
 
 pub fn run(args: CompareArgs) -> Result<ExitCode> {
@@ -91,6 +96,9 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         crate::atomic::write_atomic(path, full_table(&c).as_bytes())
             .with_context(|| format!("--full-table {}", path.display()))?;
     }
+    if let Some(path) = &args.timing_regressions_to {
+        write_timing_regressions(path, c.timing_only())?;
+    }
     let text = match args.format {
         Format::Md => {
             let limits = MarkdownLimits {
@@ -111,4 +119,21 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// `--timing-regressions-to`: the structures, comma-separated, or no file at all.
+fn write_timing_regressions(path: &std::path::Path, structures: Option<Vec<String>>) -> Result<()> {
+    let flag = || format!("--timing-regressions-to {}", path.display());
+    match structures {
+        Some(names) => {
+            crate::atomic::write_atomic(path, format!("{}\n", names.join(",")).as_bytes())
+                .with_context(flag)
+        }
+        None => match std::fs::symlink_metadata(path) {
+            Ok(m) if m.is_file() => std::fs::remove_file(path).with_context(flag),
+            Ok(_) => anyhow::bail!("{}: exists and is not a regular file", flag()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+            Err(e) => Err(e).with_context(flag),
+        },
+    }
 }

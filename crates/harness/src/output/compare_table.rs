@@ -240,6 +240,8 @@ struct JsonFinding<'a> {
     severity: &'static str,
     at: &'a str,
     what: &'a str,
+    /// The structure whose timing ratio the finding is about, for timing findings.
+    timing_of: Option<&'a str>,
 }
 
 fn severity_name(s: Severity) -> &'static str {
@@ -260,6 +262,7 @@ pub fn json(c: &Comparison, opts: &CompareOptions, only_changed: bool) -> String
             severity: severity_name(f.severity),
             at: &f.at,
             what: &f.what,
+            timing_of: f.timing_of.as_deref(),
         })
         .collect();
     let rows: Vec<&Row> = c

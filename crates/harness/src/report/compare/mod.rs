@@ -25,6 +25,10 @@
 //!   against Embree, a single-ray preset against the reference, is always advisory (see
 //!   `timing::embree_against_itself`).
 //!
+//! When every regression is a timing slowdown, [`Comparison::timing_only`] names the
+//! structures concerned, so that a script can time them again before failing
+//! (`scripts/ci-gate`): a shared machine can slow one structure for one run.
+//!
 //! Entries in the base that the new report lacks fail too (a structure that stopped building is
 //! not "no regression"), unless the comparison is of a subset (`subset`): then they are "not
 //! run" notes. Entries only in the new report are listed as new.
@@ -36,7 +40,7 @@ pub use timing::{Change, MIN_LEVEL};
 use super::run::{Report, ResultEntry, WorkloadResult, is_point_workload, throughput_unit};
 use crate::output::compare_table::{Row, row};
 use std::collections::BTreeMap;
-use timing::{compare_geomeans, embree_against_itself, timing_finding};
+use timing::{Subject, compare_geomeans, timing_finding};
 
 /// How to judge timing ratios.
 #[derive(Clone, Copy, Debug)]
@@ -82,6 +86,9 @@ pub struct Finding {
     /// What it is about: `scene / structure / workload`, `scene / structure`, or empty for
     /// the reports as a whole.
     pub at: String,
+    /// The structure whose timing ratio to the reference this finding is about; `None` for
+    /// every other kind of finding.
+    pub timing_of: Option<String>,
 }
 
 impl Finding {
@@ -90,6 +97,7 @@ impl Finding {
             severity,
             what,
             at: at.into(),
+            timing_of: None,
         }
     }
 }
@@ -108,6 +116,23 @@ impl Comparison {
             .iter()
             .filter(|f| f.severity == Severity::Regression)
             .count()
+    }
+
+    /// When there are regressions and every one is a timing slowdown: the structures they
+    /// concern (sorted, each once). `None` when there is no regression or any is of another
+    /// kind (mismatches, counters, missing entries, settings), which no second run can clear.
+    pub fn timing_only(&self) -> Option<Vec<String>> {
+        let regressions: Vec<&Finding> = self
+            .findings
+            .iter()
+            .filter(|f| f.severity == Severity::Regression)
+            .collect();
+        if regressions.is_empty() {
+            return None;
+        }
+        let names: Option<std::collections::BTreeSet<String>> =
+            regressions.iter().map(|f| f.timing_of.clone()).collect();
+        names.map(|n| n.into_iter().collect())
     }
 }
 
@@ -206,18 +231,14 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
                 );
                 continue;
             };
-            let ratio = if key.1 == new.run.reference {
-                Ratio::OfReference
-            } else if embree_against_itself(&key.1, &be.params, &new.run.reference) {
-                Ratio::EmbreeOnly
-            } else {
-                Ratio::Gated
-            };
+            // The reference's own ratio is always 1: not judged.
+            let subject = (key.1 != new.run.reference)
+                .then(|| Subject::new(&key.1, &be.params, &new.run.reference));
             // Query points, like primary and random rays, depend on the scene and seed only.
             let independent_rays =
                 matches!(bw.workload.as_str(), "primary" | "random") || bw.point_query;
             let gate_counters = comparable && (same_embree || independent_rays);
-            compare_workload(&label, bw, nw, gate_counters, ratio, opts, &mut findings);
+            compare_workload(&label, bw, nw, gate_counters, subject, opts, &mut findings);
             rows.push(row(be, ne, bw, nw, comparable, opts));
         }
     }
@@ -270,6 +291,7 @@ fn environment_warnings(
     for (what, b, n) in machine {
         if b != n {
             findings.push(Finding {
+ timing_of: None,
                 severity: Severity::Note,
                 at: String::new(),
                 what: format!(
@@ -294,6 +316,7 @@ fn environment_warnings(
         if b != n {
             comparable = false;
             findings.push(Finding {
+                timing_of: None,
                 severity: Severity::Regression,
                 at: String::new(),
                 what: format!(
@@ -331,6 +354,7 @@ fn workloads_comparable(
         .collect();
     if !added.is_empty() {
         findings.push(Finding {
+            timing_of: None,
             severity: Severity::Note,
             at: String::new(),
             what: format!("new workloads (no baseline): {}", added.join(",")),
@@ -341,6 +365,7 @@ fn workloads_comparable(
         return true;
     }
     findings.push(Finding {
+        timing_of: None,
         severity: Severity::Regression,
         at: String::new(),
         what: format!(
@@ -369,6 +394,7 @@ fn compare_build_stats(b: &ResultEntry, n: &ResultEntry, findings: &mut Vec<Find
     for (what, x, y) in figures {
         if x != y {
             findings.push(Finding {
+                timing_of: None,
                 severity: Severity::Regression,
                 at: format!("{} / {}", b.scene, b.structure),
                 what: format!(
@@ -408,7 +434,7 @@ fn compare_build_time(
             "build time ratio",
             &change,
             opts.max_scene_slowdown,
-            embree_against_itself(&b.structure, &b.params, &reference_name(b)),
+            Subject::new(&b.structure, &b.params, &reference_name(b)),
             opts,
             findings,
         );
@@ -422,29 +448,19 @@ fn reference_name(e: &ResultEntry) -> String {
         .unwrap_or_default()
 }
 
-/// How a workload's throughput ratio to the reference is judged.
-#[derive(Clone, Copy, PartialEq)]
-enum Ratio {
-    /// The reference itself (always 1): not judged.
-    OfReference,
-    /// Embree against Embree ([`embree_against_itself`]): advisory.
-    EmbreeOnly,
-    /// Gated by the thresholds.
-    Gated,
-}
-
 fn compare_workload(
     label: &str,
     b: &WorkloadResult,
     n: &WorkloadResult,
     gate_counters: bool,
-    ratio: Ratio,
+    subject: Option<Subject>,
     opts: &CompareOptions,
     findings: &mut Vec<Finding>,
 ) {
     let bad = |w: &WorkloadResult| w.agreement.counts.mismatch + w.agreement.counted_path_differs;
     if bad(n) > bad(b) {
         findings.push(Finding {
+            timing_of: None,
             severity: Severity::Regression,
             at: label.to_string(),
             what: format!("{label}: mismatches rose from {} to {}", bad(b), bad(n)),
@@ -452,6 +468,7 @@ fn compare_workload(
     }
     if gate_counters && b.counters_total != n.counters_total {
         findings.push(Finding {
+            timing_of: None,
             severity: Severity::Regression,
             at: label.to_string(),
             what: format!(
@@ -462,7 +479,7 @@ fn compare_workload(
         });
     }
     if let (Some(x), Some(y)) = (b.speedup_vs_reference, n.speedup_vs_reference)
-        && ratio != Ratio::OfReference
+        && let Some(subject) = subject
         && y > 0.0
     {
         let change = Change::new((x, b.speedup_interval), (y, n.speedup_interval), true);
@@ -472,7 +489,7 @@ fn compare_workload(
             &what,
             &change,
             opts.max_scene_slowdown,
-            ratio == Ratio::EmbreeOnly,
+            subject,
             opts,
             findings,
         );

@@ -80,11 +80,7 @@ fn words(slowdown: f64) -> String {
 /// (quality, robust mode), so no raybench code lies between the two sides of the ratio and a
 /// shift is the machine's. Such ratios are reported, never gated. The stream and packet entries
 /// stay gated: they batch the rays in raybench's wrapper.
-pub(super) fn embree_against_itself(
-    structure: &str,
-    params: &serde_json::Value,
-    reference: &str,
-) -> bool {
+fn embree_against_itself(structure: &str, params: &serde_json::Value, reference: &str) -> bool {
     let embree = |name: &str| name.starts_with("embree-");
     let batched = ["coherent_stream", "coherent_packet16"]
         .iter()
@@ -92,14 +88,29 @@ pub(super) fn embree_against_itself(
     embree(structure) && embree(reference) && !batched
 }
 
-/// `embree_only`: the ratio is Embree against Embree ([`embree_against_itself`]), advisory
-/// whatever its size.
+/// Whose timing ratio a finding is about.
+#[derive(Clone, Copy)]
+pub(super) struct Subject<'a> {
+    pub structure: &'a str,
+    /// Embree against Embree ([`embree_against_itself`]): advisory whatever its size.
+    pub embree_only: bool,
+}
+
+impl<'a> Subject<'a> {
+    pub(super) fn new(structure: &'a str, params: &serde_json::Value, reference: &str) -> Self {
+        Subject {
+            structure,
+            embree_only: embree_against_itself(structure, params, reference),
+        }
+    }
+}
+
 pub(super) fn timing_finding(
     at: &str,
     what: &str,
     change: &Change,
     threshold: f64,
-    embree_only: bool,
+    subject: Subject,
     opts: &CompareOptions,
     findings: &mut Vec<Finding>,
 ) {
@@ -145,7 +156,7 @@ pub(super) fn timing_finding(
             format!("{limit}; no confidence intervals in these reports: a point test"),
         ),
     };
-    let (severity, why) = if embree_only && severity == Severity::Regression {
+    let (severity, why) = if subject.embree_only && severity == Severity::Regression {
         (
             Severity::Advisory,
             format!("{why}; Embree against Embree, not gated: no raybench code differs"),
@@ -157,6 +168,7 @@ pub(super) fn timing_finding(
         severity,
         at: at.to_string(),
         what: format!("{at}: {what} {b:.3} -> {n:.3}: {} ({why})", change.words()),
+        timing_of: Some(subject.structure.to_string()),
     });
 }
 
@@ -234,17 +246,19 @@ pub(super) fn compare_geomeans(
         } else {
             format!("{} ratio", throughput_unit(&workload))
         };
-        let embree_only = base
+        let params = base
             .results
             .iter()
             .find(|e| e.structure == structure)
-            .is_some_and(|e| embree_against_itself(&structure, &e.params, &base.run.reference));
+            .map(|e| e.params.clone())
+            .unwrap_or_default();
+        let subject = Subject::new(&structure, &params, &base.run.reference);
         timing_finding(
             &at,
             &what,
             &change,
             opts.max_slowdown,
-            embree_only,
+            subject,
             opts,
             findings,
         );
