@@ -2,8 +2,7 @@
 //! and the list of structures a timing-only failure names for a second timing
 //! (`--timing-regressions-to`, used by scripts/ci-gate).
 
-mod common;
-
+use crate::common;
 use raybench_harness::output::compare_table::full_table;
 use raybench_harness::pipeline::run::run;
 use raybench_harness::report::compare::{CompareOptions, Comparison, Severity, compare};

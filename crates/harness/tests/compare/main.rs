@@ -1,7 +1,9 @@
 //! `raybench compare`: identical reports pass; a changed counter, a new mismatch, a changed SAH
 //! cost, a missing entry or a slowdown beyond the threshold fail; different settings are caught.
 
+#[path = "../common/mod.rs"]
 mod common;
+mod timing;
 
 use raybench_harness::output::compare_table::full_table;
 use raybench_harness::pipeline::run::run;
