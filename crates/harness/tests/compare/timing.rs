@@ -92,26 +92,16 @@ fn embree_against_embree_is_advisory_and_the_batched_entries_stay_gated() {
         e.params = params;
         old.results.push(e);
     }
-    for e in &mut old.results {
-        let s = e.workloads[0].speedup_vs_reference.unwrap();
-        e.workloads[0].speedup_interval = Some(narrow(s));
-    }
     let mut new = old.clone();
-    for e in new
-        .results
-        .iter_mut()
-        .filter(|e| e.structure != "embree-medium")
-    {
-        let w = &mut e.workloads[0];
-        let s = w.speedup_vs_reference.unwrap() / 1.2; // 20 % slower
-        w.speedup_vs_reference = Some(s);
-        w.speedup_interval = Some(narrow(s));
+    for s in [
+        "bruteforce",
+        "bvh-binned",
+        "embree-robust",
+        "embree-medium-stream",
+    ] {
+        slow(&mut new, s);
     }
-    let strict = CompareOptions {
-        max_scene_slowdown: 0.10,
-        ..CompareOptions::default()
-    };
-    let c = compare(&old, &new, &strict);
+    let c = compare(&old, &new, &strict());
     let of = |name: &str, severity: Severity| {
         c.findings
             .iter()

@@ -290,15 +290,14 @@ fn environment_warnings(
     ];
     for (what, b, n) in machine {
         if b != n {
-            findings.push(Finding {
- timing_of: None,
-                severity: Severity::Note,
-                at: String::new(),
-                what: format!(
-                    "WARNING: different environments ({what}: base `{b}`, new `{n}`): timing ratios \
-                     are less comparable"
+            findings.push(Finding::about(
+                Severity::Note,
+                String::new(),
+                format!(
+                    "WARNING: different environments ({what}: base `{b}`, new `{n}`): timing \
+                     ratios are less comparable"
                 ),
-            });
+            ));
         }
     }
     let (br, nr) = (&base.run, &new.run);
@@ -315,15 +314,14 @@ fn environment_warnings(
     for (what, b, n) in settings {
         if b != n {
             comparable = false;
-            findings.push(Finding {
-                timing_of: None,
-                severity: Severity::Regression,
-                at: String::new(),
-                what: format!(
+            findings.push(Finding::about(
+                Severity::Regression,
+                String::new(),
+                format!(
                     "different run settings ({what}: base `{b}`, new `{n}`): deterministic figures \
                      cannot be compared; regenerate the baseline with the same settings"
                 ),
-            });
+            ));
         }
     }
     comparable
@@ -353,28 +351,26 @@ fn workloads_comparable(
         .map(String::as_str)
         .collect();
     if !added.is_empty() {
-        findings.push(Finding {
-            timing_of: None,
-            severity: Severity::Note,
-            at: String::new(),
-            what: format!("new workloads (no baseline): {}", added.join(",")),
-        });
+        findings.push(Finding::about(
+            Severity::Note,
+            String::new(),
+            format!("new workloads (no baseline): {}", added.join(",")),
+        ));
     }
     // A subset runs fewer workloads on purpose; the ones it ran still compare.
     if dropped.is_empty() || opts.subset {
         return true;
     }
-    findings.push(Finding {
-        timing_of: None,
-        severity: Severity::Regression,
-        at: String::new(),
-        what: format!(
+    findings.push(Finding::about(
+        Severity::Regression,
+        String::new(),
+        format!(
             "different run settings (workloads: base `{}`, new `{}`): deterministic figures \
              cannot be compared; regenerate the baseline with the same settings",
             base.join(","),
             new.join(",")
         ),
-    });
+    ));
     false
 }
 
@@ -393,18 +389,17 @@ fn compare_build_stats(b: &ResultEntry, n: &ResultEntry, findings: &mut Vec<Find
     ];
     for (what, x, y) in figures {
         if x != y {
-            findings.push(Finding {
-                timing_of: None,
-                severity: Severity::Regression,
-                at: format!("{} / {}", b.scene, b.structure),
-                what: format!(
+            findings.push(Finding::about(
+                Severity::Regression,
+                format!("{} / {}", b.scene, b.structure),
+                format!(
                     "{} / {}: {what} changed from {} to {} (deterministic)",
                     b.scene,
                     b.structure,
                     show(x),
                     show(y)
                 ),
-            });
+            ));
         }
     }
 }
@@ -459,24 +454,22 @@ fn compare_workload(
 ) {
     let bad = |w: &WorkloadResult| w.agreement.counts.mismatch + w.agreement.counted_path_differs;
     if bad(n) > bad(b) {
-        findings.push(Finding {
-            timing_of: None,
-            severity: Severity::Regression,
-            at: label.to_string(),
-            what: format!("{label}: mismatches rose from {} to {}", bad(b), bad(n)),
-        });
+        findings.push(Finding::about(
+            Severity::Regression,
+            label.to_string(),
+            format!("{label}: mismatches rose from {} to {}", bad(b), bad(n)),
+        ));
     }
     if gate_counters && b.counters_total != n.counters_total {
-        findings.push(Finding {
-            timing_of: None,
-            severity: Severity::Regression,
-            at: label.to_string(),
-            what: format!(
+        findings.push(Finding::about(
+            Severity::Regression,
+            label.to_string(),
+            format!(
                 "{label}: counters changed (deterministic): {} -> {}",
                 counters_text(b),
                 counters_text(n)
             ),
-        });
+        ));
     }
     if let (Some(x), Some(y)) = (b.speedup_vs_reference, n.speedup_vs_reference)
         && let Some(subject) = subject

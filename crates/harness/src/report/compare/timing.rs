@@ -250,9 +250,8 @@ pub(super) fn compare_geomeans(
             .results
             .iter()
             .find(|e| e.structure == structure)
-            .map(|e| e.params.clone())
-            .unwrap_or_default();
-        let subject = Subject::new(&structure, &params, &base.run.reference);
+            .map_or(&serde_json::Value::Null, |e| &e.params);
+        let subject = Subject::new(&structure, params, &base.run.reference);
         timing_finding(
             &at,
             &what,
