@@ -162,3 +162,45 @@ fn bad_bins_are_refused_and_the_budget_is_in_the_estimate() {
     };
     assert_eq!(needed(1.0), 2 * needed(0.0));
 }
+
+/// The overlap share decides where a spatial split is searched for: the higher it is, the
+/// fewer nodes search (a knob that changed nothing would fail here); every split taken was
+/// searched for; and at each share the splits still pay on hair.
+#[test]
+fn the_overlap_share_limits_where_spatial_splits_are_searched() {
+    let mesh = raybench_testkit::generated("hair:triangles=5000", 3);
+    let binned = stats(&mesh, &WideParams::for_width(8));
+    let mut searched_before = f64::INFINITY;
+    for share in [0.0, 0.3, 0.9] {
+        let mut p = WideParams::sbvh();
+        p.binary.spatial_splits.as_mut().unwrap().overlap_share = share;
+        let s = stats(&mesh, &p);
+        let (splits, searched) = (s.extra["spatial_splits"], s.extra["spatial_searches"]);
+        let context = format!("share {share}: {s:?}");
+        assert!(searched < searched_before, "{context}");
+        assert!(splits > 0.0 && splits <= searched, "{context}");
+        assert!(s.sah_cost.unwrap() < binned.sah_cost.unwrap(), "{context}");
+        searched_before = searched;
+    }
+}
+
+/// An overlap share outside 0 to 1 (or NaN) is refused before the build; both ends are taken.
+#[test]
+fn an_overlap_share_outside_0_to_1_is_refused() {
+    use raybench_accel::BuildError;
+    let mesh = raybench_testkit::generated("soup:triangles=2000", 1);
+    let with = |share: f32| {
+        let mut p = BvhParams::sbvh();
+        p.spatial_splits.as_mut().unwrap().overlap_share = share;
+        Bvh::build(mesh.clone(), &p)
+    };
+    for share in [-0.1, 1.5, f32::NAN] {
+        assert!(
+            matches!(with(share), Err(BuildError::Unsupported(ref m)) if m.contains("overlap_share")),
+            "{share}"
+        );
+    }
+    for share in [0.0, 1.0] {
+        with(share).expect("builds");
+    }
+}

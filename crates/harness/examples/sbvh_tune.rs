@@ -10,7 +10,7 @@
 //!
 //! `cargo run --release -p raybench-harness --example sbvh_tune -- hair 2 5 1e-5,0.5,32 1e-4,0.5,32`
 //! (scene: an .obj path or a generator spec; threads; rounds; then one
-//! `alpha,growth,bins[,intersection_cost]` per configuration).
+//! `alpha,growth,bins[,intersection_cost[,overlap_share]]` per configuration).
 
 use raybench_accel::Accel;
 use raybench_bvh::{Bvh8, SpatialSplits, WideParams};
@@ -29,11 +29,13 @@ fn main() {
     let configs: Vec<SpatialSplits> = args
         .map(|a| {
             let v: Vec<f32> = a.split(',').map(|x| x.parse().expect("a number")).collect();
+            let d = SpatialSplits::default();
             SpatialSplits {
                 alpha: v[0],
                 max_reference_growth: v[1],
                 spatial_bins: v[2] as u32,
-                intersection_cost: v.get(3).copied().unwrap_or(1.0),
+                intersection_cost: v.get(3).copied().unwrap_or(d.intersection_cost),
+                overlap_share: v.get(4).copied().unwrap_or(d.overlap_share),
             }
         })
         .collect();
@@ -53,8 +55,8 @@ fn main() {
         let mut p = WideParams::sbvh();
         p.binary.spatial_splits = Some(*c);
         let name = format!(
-            "sbvh {},{},{}",
-            c.alpha, c.max_reference_growth, c.spatial_bins
+            "sbvh {},{},{},{}",
+            c.alpha, c.max_reference_growth, c.spatial_bins, c.overlap_share
         );
         params.push((name, p));
     }
@@ -93,11 +95,12 @@ fn main() {
         let s = stats[i].as_ref().expect("built");
         let extra = |k: &str| s.extra.get(k).copied().unwrap_or(f64::NAN);
         println!(
-            "{name:24} {ms:9.1} ms {:6.2}x high  sah {:10.3}  growth {:.3}  splits {}  random ray: {:.2} nodes {:.2} tests",
+            "{name:24} {ms:9.1} ms {:6.2}x high  sah {:10.3}  growth {:.3}  splits {} of {} searched  random ray: {:.2} nodes {:.2} tests",
             ms / high_ms,
             s.sah_cost.unwrap_or(f64::NAN),
             extra("reference_growth"),
             extra("spatial_splits"),
+            extra("spatial_searches"),
             work[i].0,
             work[i].1
         );

@@ -92,6 +92,12 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
                 s.spatial_bins
             )));
         }
+        if !(0.0..=1.0).contains(&s.overlap_share) {
+            return Err(BuildError::Unsupported(format!(
+                "overlap_share from 0 to 1 (got {})",
+                s.overlap_share
+            )));
+        }
         return Ok(spatial::build(mesh, params, s));
     }
     let mut refs: Vec<PrimRef> = (0..n)

@@ -9,6 +9,7 @@ use super::chop::{Corners, corners, is_empty, split_estimate};
 use crate::BvhParams;
 use crate::build::split::split_cost;
 use crate::build::{Box3, PrimRef};
+use glam::Vec3A;
 use raybench_geom::TriangleMesh;
 
 /// Upper bound of the `spatial_bins` knob: the slabs live in fixed arrays reused by every node
@@ -31,18 +32,18 @@ pub(crate) struct SpatialSplit {
 /// Per axis and slab: the box of the pieces of references inside it, how many references
 /// start in it and how many end in it; and the sweep's right-hand sides.
 pub(crate) struct SlabBins {
-    boxes: [Box3; MAX_SPATIAL_BINS],
-    enter: [u32; MAX_SPATIAL_BINS],
-    exit: [u32; MAX_SPATIAL_BINS],
+    boxes: [[Box3; MAX_SPATIAL_BINS]; 3],
+    enter: [[u32; MAX_SPATIAL_BINS]; 3],
+    exit: [[u32; MAX_SPATIAL_BINS]; 3],
     right: [(Box3, u32); MAX_SPATIAL_BINS],
 }
 
 impl SlabBins {
     pub(crate) fn new() -> Box<SlabBins> {
         Box::new(SlabBins {
-            boxes: [Box3::EMPTY; MAX_SPATIAL_BINS],
-            enter: [0; MAX_SPATIAL_BINS],
-            exit: [0; MAX_SPATIAL_BINS],
+            boxes: [[Box3::EMPTY; MAX_SPATIAL_BINS]; 3],
+            enter: [[0; MAX_SPATIAL_BINS]; 3],
+            exit: [[0; MAX_SPATIAL_BINS]; 3],
             right: [(Box3::EMPTY, 0); MAX_SPATIAL_BINS],
         })
     }
@@ -68,46 +69,80 @@ pub(crate) fn best_spatial_split(
     let nb = slabs.clamp(2, MAX_SPATIAL_BINS);
     let n = refs.len();
     let mut best: Option<SpatialSplit> = None;
-    for axis in 0..3 {
-        let lo = bounds.lo[axis];
-        let extent = bounds.hi[axis] - lo;
-        if extent <= 0.0 {
-            continue;
+    // All three axes a pass over the references, so a reference crossing slab planes on
+    // several axes fetches its triangle from the mesh once. Per lane, the same arithmetic as
+    // one axis at a time: `extent / nb`, then `(x - lo) / step`.
+    let (lo, extent) = (bounds.lo, bounds.hi - bounds.lo);
+    let step = extent / nb as f32;
+    let slabs_of = |x: Vec3A| ((x - lo) / step).to_array().map(|s| (s as usize).min(nb - 1));
+    let mut live = [0, 1, 2].map(|axis| extent[axis] > 0.0);
+    for axis in (0..3).filter(|&a| live[a]) {
+        bins.boxes[axis][..nb].fill(Box3::EMPTY);
+        bins.enter[axis][..nb].fill(0);
+        bins.exit[axis][..nb].fill(0);
+    }
+    // First the counts alone: a plane duplicates the references that cross it, so an axis
+    // none of whose planes leaves both sides a reference within the budget needs no chopping
+    // (deep in the tree, where the budget left is small, that is most axes). The planes the
+    // sweep below can choose are the same either way.
+    for r in refs {
+        let b = r.bounds();
+        let (first, last) = (slabs_of(b.lo), slabs_of(b.hi));
+        for axis in (0..3).filter(|&a| live[a]) {
+            bins.enter[axis][first[axis]] += 1;
+            bins.exit[axis][last[axis]] += 1;
         }
-        let step = extent / nb as f32;
-        let plane = |b: usize| lo + step * b as f32;
-        let slab = |x: f32| (((x - lo) / step) as usize).min(nb - 1);
-        bins.boxes[..nb].fill(Box3::EMPTY);
-        bins.enter[..nb].fill(0);
-        bins.exit[..nb].fill(0);
-        for r in refs {
-            let b = r.bounds();
-            let (first, last) = (slab(b.lo[axis]), slab(b.hi[axis]));
-            bins.enter[first] += 1;
-            bins.exit[last] += 1;
+    }
+    for (axis, live) in live.iter_mut().enumerate().filter(|(_, l)| **l) {
+        let (mut entered, mut exited) = (0, 0);
+        *live = (1..nb).any(|b| {
+            entered += bins.enter[axis][b - 1] as usize;
+            exited += bins.exit[axis][b - 1] as usize;
+            // Left: the references entering before the plane; right: those not leaving
+            // before it; both: those crossing it.
+            let (lc, rc) = (entered, n - exited);
+            lc > 0 && rc > 0 && lc + rc - n <= budget
+        });
+    }
+    if !live.contains(&true) {
+        return None;
+    }
+    for r in refs {
+        let b = r.bounds();
+        let (first, last) = (slabs_of(b.lo), slabs_of(b.hi));
+        let mut tri: Option<Corners> = None;
+        for axis in (0..3).filter(|&a| live[a]) {
+            let (first, last) = (first[axis], last[axis]);
             if first == last {
-                bins.boxes[first] = bins.boxes[first].union(&b);
+                bins.boxes[axis][first] = bins.boxes[axis][first].union(&b);
                 continue;
             }
+            let tri = tri.get_or_insert_with(|| corners(&mesh.triangle(r.id() as usize)));
+            let (lo, step) = (lo[axis], step[axis]);
             chop_into_slabs(
-                &corners(&mesh.triangle(r.id() as usize)),
+                tri,
                 axis,
                 b,
                 first..=last,
-                &plane,
-                &mut bins.boxes,
+                &|b: usize| lo + step * b as f32,
+                &mut bins.boxes[axis],
             );
         }
+    }
+    for axis in (0..3).filter(|&a| live[a]) {
+        let (lo, step) = (lo[axis], step[axis]);
+        let plane = |b: usize| lo + step * b as f32;
+        let (boxes, enter, exit) = (&bins.boxes[axis], &bins.enter[axis], &bins.exit[axis]);
         let (mut acc, mut count) = (Box3::EMPTY, 0u32);
         for b in (1..nb).rev() {
-            acc = acc.union(&bins.boxes[b]);
-            count += bins.exit[b];
+            acc = acc.union(&boxes[b]);
+            count += exit[b];
             bins.right[b] = (acc, count);
         }
         let (mut left, mut left_count) = (Box3::EMPTY, 0u32);
         for b in 1..nb {
-            left = left.union(&bins.boxes[b - 1]);
-            left_count += bins.enter[b - 1];
+            left = left.union(&boxes[b - 1]);
+            left_count += enter[b - 1];
             let (right, right_count) = bins.right[b];
             let (lc, rc) = (left_count as usize, right_count as usize);
             if lc == 0 || rc == 0 || lc + rc - n > budget {
@@ -153,4 +188,56 @@ fn chop_into_slabs(
         rest = beyond;
     }
     boxes[last] = boxes[last].union(&rest);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::WideParams;
+    use crate::build::spatial::chop::box_of;
+    use raybench_geom::Vec3;
+
+    /// Slanted triangles each spanning the whole box in y and z (so every plane on those axes
+    /// cuts them all): ten narrow ones near x = 0, ten near x = 1, and three spanning x too.
+    fn walls() -> TriangleMesh {
+        let mut spans: Vec<(f32, f32)> = (0..10)
+            .flat_map(|k| {
+                let a = 0.01 * k as f32;
+                [(a, a + 0.01), (0.9 + a, 0.91 + a)]
+            })
+            .collect();
+        spans.extend([(0.0, 1.0); 3]);
+        let mut vertices = Vec::new();
+        let mut indices = Vec::new();
+        for (a, b) in spans {
+            let base = vertices.len() as u32;
+            vertices.push(Vec3::new(a, 0.0, 0.0));
+            vertices.push(Vec3::new(b, 1.0, 0.0));
+            vertices.push(Vec3::new(a, 0.0, 1.0));
+            indices.push([base, base + 1, base + 2]);
+        }
+        TriangleMesh::new(vertices, indices)
+            .expect("a valid mesh")
+            .0
+    }
+
+    /// The cheapest plane cuts only the three long triangles; a budget of three admits it, a
+    /// budget of two admits no plane on any axis (the counts rule every axis out before any
+    /// reference is chopped), and the answer is `None`, not a plane over the budget.
+    #[test]
+    fn a_plane_is_a_candidate_only_within_the_budget() {
+        let mesh = walls();
+        let refs: Vec<PrimRef> = (0..mesh.len())
+            .map(|i| PrimRef::new(&mesh.triangle(i).bounds(), i as u32))
+            .collect();
+        let bounds = box_of(&mesh.bounds());
+        let p = WideParams::default().binary;
+        let mut bins = SlabBins::new();
+        let s = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 3, &mut bins)
+            .expect("a plane within a budget of three");
+        assert_eq!(s.axis, 0);
+        assert_eq!(s.left_count + s.right_count - refs.len(), 3);
+        assert!(s.pos > 0.1 && s.pos < 0.9, "{s:?}");
+        assert!(best_spatial_split(&refs, &mesh, &bounds, &p, 16, 2, &mut bins).is_none());
+    }
 }

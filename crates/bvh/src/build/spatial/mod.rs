@@ -5,7 +5,8 @@
 //! children overlap, cutting them shrinks the boxes a ray must enter, at the price of more
 //! references (a triangle may be tested twice on a ray) and a slower build. Two limits keep
 //! the price down: a spatial split is only tried where the object split's children overlap by
-//! more than `alpha` × the root's area, and the references may grow to at most
+//! more than `alpha` × the root's area and by at least `overlap_share` × the node's own area
+//! (as in Embree's spatial-split builder), and the references may grow to at most
 //! `1 + max_reference_growth` times the triangles, a budget shared top-down between the
 //! children in proportion to their references (as Embree's spatial-split builder shares its
 //! extra space), so the tree does not depend on which task builds what first. Below a node
@@ -28,13 +29,14 @@ use super::split::{PARALLEL_BINNING, Scratch, Split, binned_split, leaf_beats_an
 use super::split::{split_cost, worth_splitting};
 use super::{Flat, Part, Ranged, build_local, build_part, interior};
 use crate::BvhParams;
-use crate::build::PrimRef;
+use crate::build::{Box3, PrimRef};
 use crate::node::{ChildRef, MAX_DEPTH, Node};
-use bins::{SlabBins, best_spatial_split};
+use bins::{SlabBins, SpatialSplit, best_spatial_split};
 use divide::{Divided, divide};
 use raybench_geom::{Aabb, TriangleMesh};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The knobs of spatial splits (`BvhParams::spatial_splits`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -64,6 +66,14 @@ pub struct SpatialSplits {
     /// 644; 8 gives 7399 in 302 ms (`examples/sbvh_tune`, 2 threads, 2026-11-26, with
     /// `intersection_cost` at 0.15).
     pub spatial_bins: u32,
+    /// A spatial split is tried at a node only when, besides `alpha`, the boxes of its best
+    /// object split's children overlap by at least this share of the node's own surface area
+    /// (Embree's spatial-split builder makes the same test, with 0.1). Where the children
+    /// barely overlap, a cut through their triangles has little to win, yet the search — every
+    /// reference chopped at every slab plane of three axes — had been most of the build.
+    /// 0.3 (from 0 to 1): see docs/experiments.md, "spatial splits searched only where the
+    /// object split's children overlap by a share of the node".
+    pub overlap_share: f32,
 }
 
 impl Default for SpatialSplits {
@@ -73,6 +83,7 @@ impl Default for SpatialSplits {
             max_reference_growth: 0.5,
             spatial_bins: 16,
             intersection_cost: 1.0,
+            overlap_share: 0.3,
         }
     }
 }
@@ -81,6 +92,9 @@ impl Default for SpatialSplits {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct SpatialReport {
     pub spatial_splits: u64,
+    /// Nodes where a spatial split was searched for (taken or not): what the build time
+    /// follows.
+    pub spatial_searches: u64,
 }
 
 /// The fixed inputs of every node.
@@ -92,6 +106,9 @@ struct Ctx<'a> {
     min_overlap: f64,
     /// The binary builder's knobs with the spatial splits' `intersection_cost`.
     priced: BvhParams,
+    /// Spatial splits searched for so far, on every task: a count of a set of nodes that does
+    /// not depend on the tasks, so the total does not either.
+    searches: AtomicU64,
 }
 
 /// A subtree as the spatial builder returns it, before flattening.
@@ -141,6 +158,7 @@ pub(crate) fn build(mesh: &TriangleMesh, p: &BvhParams, s: &SpatialSplits) -> Fl
             intersection_cost: s.intersection_cost,
             ..p.clone()
         },
+        searches: AtomicU64::new(0),
     };
     let budget = (n as f64 * s.max_reference_growth.max(0.0) as f64) as usize;
     let tree = ctx.node(refs, whole, 0, budget, &mut Work::new());
@@ -152,6 +170,9 @@ pub(crate) fn build(mesh: &TriangleMesh, p: &BvhParams, s: &SpatialSplits) -> Fl
         spatial: Some(SpatialReport::default()),
     };
     out.root = tree.flatten(&mut out);
+    if let Some(s) = out.spatial.as_mut() {
+        s.spatial_searches = ctx.searches.into_inner();
+    }
     out
 }
 
@@ -191,15 +212,8 @@ impl Ctx<'_> {
             }
         });
         if overlap > self.min_overlap
-            && let Some(s) = best_spatial_split(
-                &refs,
-                self.mesh,
-                &r.bounds,
-                q,
-                self.s.spatial_bins as usize,
-                budget,
-                &mut w.slabs,
-            )
+            && overlap >= self.s.overlap_share as f64 * parent
+            && let Some(s) = self.search(&refs, &r.bounds, budget, w)
             && object_cost.is_none_or(|c| s.cost < c)
             && worth_splitting(q, n, s.cost)
             && let Some(d) = divide(&refs, self.mesh, &s)
@@ -220,6 +234,26 @@ impl Ctx<'_> {
             duplicates: 0,
         };
         self.children(d, budget, depth, false, w)
+    }
+
+    /// The cheapest spatial split of a node's references, counted for the report.
+    fn search(
+        &self,
+        refs: &[PrimRef],
+        bounds: &Box3,
+        budget: usize,
+        w: &mut Work,
+    ) -> Option<SpatialSplit> {
+        self.searches.fetch_add(1, Ordering::Relaxed);
+        best_spatial_split(
+            refs,
+            self.mesh,
+            bounds,
+            &self.priced,
+            self.s.spatial_bins as usize,
+            budget,
+            &mut w.slabs,
+        )
     }
 
     /// Builds both children of a split, sharing the budget left in proportion to their
@@ -332,6 +366,9 @@ pub(crate) fn spatial_stats(
     stats
         .extra
         .insert("spatial_splits".into(), r.spatial_splits as f64);
+    stats
+        .extra
+        .insert("spatial_searches".into(), r.spatial_searches as f64);
     stats.extra.insert(
         "reference_growth".into(),
         stats.refs as f64 / triangles.max(1) as f64,
