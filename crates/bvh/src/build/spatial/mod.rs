@@ -64,7 +64,8 @@ pub struct SpatialSplits {
     /// Slabs per axis in the spatial split's binning (at most [`MAX_SPATIAL_BINS`]). 16: on
     /// hair (50,000 triangles) the same SAH cost as 32 (7389 against 7394) in 403 ms instead of
     /// 644; 8 gives 7399 in 302 ms (`examples/sbvh_tune`, 2 threads, 2026-11-26, with
-    /// `intersection_cost` at 0.15).
+    /// `intersection_cost` at 0.15). With `overlap_share` at 0.3, 8 slabs leave city's SAH cost
+    /// above the binned tree's (docs/experiments.md, "8 slabs instead of 16").
     pub spatial_bins: u32,
     /// A spatial split is tried at a node only when, besides `alpha`, the boxes of its best
     /// object split's children overlap by at least this share of the node's own surface area
@@ -219,7 +220,7 @@ impl Ctx<'_> {
             && let Some(d) = divide(&refs, self.mesh, &s)
         {
             drop(refs);
-            return self.children(d, budget, depth, true, w);
+            return self.children(d, None, budget, depth, true, w);
         }
         let split = match object {
             Some(o) => o,
@@ -233,7 +234,9 @@ impl Ctx<'_> {
             right,
             duplicates: 0,
         };
-        self.children(d, budget, depth, false, w)
+        // The split measured both sides already (the bins' boxes are the unions of the
+        // records' boxes), so no pass over them again.
+        self.children(d, Some([split.left, split.right]), budget, depth, false, w)
     }
 
     /// The cheapest spatial split of a node's references, counted for the report.
@@ -256,11 +259,12 @@ impl Ctx<'_> {
         )
     }
 
-    /// Builds both children of a split, sharing the budget left in proportion to their
-    /// references (on two rayon tasks above the parallel threshold).
+    /// Builds both children of a split (`measured`: their bounds, when known), sharing the
+    /// budget left in proportion to their references (on two rayon tasks above the parallel threshold).
     fn children(
         &self,
         d: Divided,
+        measured: Option<[Ranged; 2]>,
         budget: usize,
         depth: usize,
         spatial: bool,
@@ -270,10 +274,12 @@ impl Ctx<'_> {
         let rest = budget.saturating_sub(d.duplicates);
         let left_budget = (rest as u128 * nl as u128 / (nl + nr) as u128) as usize;
         let right_budget = rest - left_budget;
-        let (left, right) = (
-            Ranged::of(&d.left, PARALLEL_BINNING),
-            Ranged::of(&d.right, PARALLEL_BINNING),
-        );
+        let [left, right] = measured.unwrap_or_else(|| {
+            [
+                Ranged::of(&d.left, PARALLEL_BINNING),
+                Ranged::of(&d.right, PARALLEL_BINNING),
+            ]
+        });
         let bounds = [left.bounds.to_aabb(), right.bounds.to_aabb()];
         let children = if nl + nr > self.p.parallel_threshold as usize {
             rayon::join(
