@@ -74,7 +74,11 @@ pub(crate) fn best_spatial_split(
     // one axis at a time: `extent / nb`, then `(x - lo) / step`.
     let (lo, extent) = (bounds.lo, bounds.hi - bounds.lo);
     let step = extent / nb as f32;
-    let slabs_of = |x: Vec3A| ((x - lo) / step).to_array().map(|s| (s as usize).min(nb - 1));
+    let slabs_of = |x: Vec3A| {
+        ((x - lo) / step)
+            .to_array()
+            .map(|s| (s as usize).min(nb - 1))
+    };
     let mut live = [0, 1, 2].map(|axis| extent[axis] > 0.0);
     for axis in (0..3).filter(|&a| live[a]) {
         bins.boxes[axis][..nb].fill(Box3::EMPTY);
