@@ -70,8 +70,9 @@ pub struct SpatialSplits {
     /// A spatial split is tried at a node only when, besides `alpha`, the boxes of its best
     /// object split's children overlap by at least this share of the node's own surface area
     /// (Embree's spatial-split builder makes the same test, with 0.1). Where the children
-    /// barely overlap, a cut through their triangles has little to win, yet the search — every
-    /// reference chopped at every slab plane of three axes — had been most of the build.
+    /// barely overlap, a cut through their triangles has little to win, while the search —
+    /// every reference chopped at every slab plane of three axes — costs more than the rest of
+    /// the node's work together.
     /// 0.3 (from 0 to 1): see docs/experiments.md, "spatial splits searched only where the
     /// object split's children overlap by a share of the node".
     pub overlap_share: f32,
