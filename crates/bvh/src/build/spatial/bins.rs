@@ -74,6 +74,7 @@ pub(crate) fn best_spatial_split(
     // one axis at a time: `extent / nb`, then `(x - lo) / step`.
     let (lo, extent) = (bounds.lo, bounds.hi - bounds.lo);
     let step = extent / nb as f32;
+    let plane = |axis: usize, b: usize| lo[axis] + step[axis] * b as f32;
     let slabs_of = |x: Vec3A| {
         ((x - lo) / step)
             .to_array()
@@ -104,8 +105,7 @@ pub(crate) fn best_spatial_split(
             exited += bins.exit[axis][b - 1] as usize;
             // Left: the references entering before the plane; right: those not leaving
             // before it; both: those crossing it.
-            let (lc, rc) = (entered, n - exited);
-            lc > 0 && rc > 0 && lc + rc - n <= budget
+            candidate(entered, n - exited, n, budget)
         });
     }
     if !live.contains(&true) {
@@ -122,20 +122,17 @@ pub(crate) fn best_spatial_split(
                 continue;
             }
             let tri = tri.get_or_insert_with(|| corners(&mesh.triangle(r.id() as usize)));
-            let (lo, step) = (lo[axis], step[axis]);
             chop_into_slabs(
                 tri,
                 axis,
                 b,
                 first..=last,
-                &|b: usize| lo + step * b as f32,
+                &|b: usize| plane(axis, b),
                 &mut bins.boxes[axis],
             );
         }
     }
     for axis in (0..3).filter(|&a| live[a]) {
-        let (lo, step) = (lo[axis], step[axis]);
-        let plane = |b: usize| lo + step * b as f32;
         let (boxes, enter, exit) = (&bins.boxes[axis], &bins.enter[axis], &bins.exit[axis]);
         let (mut acc, mut count) = (Box3::EMPTY, 0u32);
         for b in (1..nb).rev() {
@@ -149,14 +146,14 @@ pub(crate) fn best_spatial_split(
             left_count += enter[b - 1];
             let (right, right_count) = bins.right[b];
             let (lc, rc) = (left_count as usize, right_count as usize);
-            if lc == 0 || rc == 0 || lc + rc - n > budget {
+            if !candidate(lc, rc, n, budget) {
                 continue;
             }
             let cost = split_cost(p, parent, (left.half_area(), lc), (right.half_area(), rc));
             if best.is_none_or(|s| cost < s.cost) {
                 best = Some(SpatialSplit {
                     axis,
-                    pos: plane(b),
+                    pos: plane(axis, b),
                     cost,
                     left,
                     right,
@@ -167,6 +164,13 @@ pub(crate) fn best_spatial_split(
         }
     }
     best
+}
+
+/// Whether a plane with `lc` references on its left and `rc` on its right (those crossing it
+/// on both) is a candidate: both sides hold one, and the crossings fit the budget.
+#[inline(always)]
+fn candidate(lc: usize, rc: usize, n: usize, budget: usize) -> bool {
+    lc > 0 && rc > 0 && lc + rc - n <= budget
 }
 
 /// Adds the pieces of one reference (box `b`, triangle `tri`) to the slabs `range` it spans

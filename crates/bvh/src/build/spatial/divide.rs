@@ -7,7 +7,7 @@
 
 use super::bins::SpatialSplit;
 use super::chop::{corners, is_empty, split_at};
-use crate::build::PrimRef;
+use crate::build::{PrimRef, Ranged};
 use raybench_geom::TriangleMesh;
 
 /// The two children's references, and how many references the split added.
@@ -15,6 +15,9 @@ pub(crate) struct Divided {
     pub left: Vec<PrimRef>,
     pub right: Vec<PrimRef>,
     pub duplicates: usize,
+    /// Both sides' bounds, when the split measured them already (an object split: its bins'
+    /// boxes are the unions of the records' boxes), so the children need no pass over them.
+    pub measured: Option<[Ranged; 2]>,
 }
 
 /// Splits `refs` at `s`; `None` when a side would be left empty (the binning estimate and the
@@ -75,6 +78,7 @@ pub(crate) fn divide(refs: &[PrimRef], mesh: &TriangleMesh, s: &SpatialSplit) ->
         left,
         right,
         duplicates,
+        measured: None,
     })
 }
 

@@ -221,7 +221,7 @@ impl Ctx<'_> {
             && let Some(d) = divide(&refs, self.mesh, &s)
         {
             drop(refs);
-            return self.children(d, None, budget, depth, true, w);
+            return self.children(d, budget, depth, true, w);
         }
         let split = match object {
             Some(o) => o,
@@ -234,10 +234,9 @@ impl Ctx<'_> {
             left: refs,
             right,
             duplicates: 0,
+            measured: Some([split.left, split.right]),
         };
-        // The split measured both sides already (the bins' boxes are the unions of the
-        // records' boxes), so no pass over them again.
-        self.children(d, Some([split.left, split.right]), budget, depth, false, w)
+        self.children(d, budget, depth, false, w)
     }
 
     /// The cheapest spatial split of a node's references, counted for the report.
@@ -260,12 +259,11 @@ impl Ctx<'_> {
         )
     }
 
-    /// Builds both children of a split (`measured`: their bounds, when known), sharing the
-    /// budget left in proportion to their references (on two rayon tasks above the parallel threshold).
+    /// Builds both children of a split, sharing the budget left in proportion to their
+    /// references (on two rayon tasks above the parallel threshold).
     fn children(
         &self,
         d: Divided,
-        measured: Option<[Ranged; 2]>,
         budget: usize,
         depth: usize,
         spatial: bool,
@@ -275,7 +273,7 @@ impl Ctx<'_> {
         let rest = budget.saturating_sub(d.duplicates);
         let left_budget = (rest as u128 * nl as u128 / (nl + nr) as u128) as usize;
         let right_budget = rest - left_budget;
-        let [left, right] = measured.unwrap_or_else(|| {
+        let [left, right] = d.measured.unwrap_or_else(|| {
             [
                 Ranged::of(&d.left, PARALLEL_BINNING),
                 Ranged::of(&d.right, PARALLEL_BINNING),
