@@ -9,7 +9,8 @@
 //! harness does (`Workers::start`). The device is created before the first timed build and
 //! kept alive, so no timed build pays for Embree's thread start-up.
 //!
-//! `bvh-bin4` is the binary tree the 8-wide BVH is collapsed from (`WideParams::default()`'s
+//! `bvh-sbvh` is the binary tree `bvh8-sbvh` is collapsed from (spatial splits at their
+//! defaults). `bvh-bin4` is the binary tree the 8-wide BVH is collapsed from (`WideParams::default()`'s
 //! `binary` knobs) built and flattened on its own: the difference to `bvh8` is the collapse and
 //! the `Tri4` leaves. The digests identify the trees (nodes and triangle order), to check
 //! that a builder change keeps them identical, and with any thread count.
@@ -85,6 +86,7 @@ fn main() {
         ..WideParams::default()
     };
     let bin4 = wide.binary.clone();
+    let sbvh = WideParams::sbvh().binary;
 
     type Build<'a> = Box<dyn Fn() -> Box<dyn Accel> + Sync + 'a>;
     let structures: Vec<(&str, Build)> = vec![
@@ -99,6 +101,10 @@ fn main() {
         (
             "bvh-bin4",
             Box::new(|| Box::new(Bvh::build(Arc::clone(&mesh), &bin4).expect("builds"))),
+        ),
+        (
+            "bvh-sbvh",
+            Box::new(|| Box::new(Bvh::build(Arc::clone(&mesh), &sbvh).expect("builds"))),
         ),
         (
             "bvh8",
@@ -151,14 +157,17 @@ fn main() {
     pool.install(|| {
         let b = Bvh::build(Arc::clone(&mesh), &binned).expect("builds");
         let b4 = Bvh::build(Arc::clone(&mesh), &bin4).expect("builds");
+        let s = Bvh::build(Arc::clone(&mesh), &sbvh).expect("builds");
         let w = Bvh8::build(Arc::clone(&mesh), &wide).expect("builds");
         let sah = |a: &dyn Accel| a.build_stats().sah_cost.unwrap_or(f64::NAN);
         println!(
-            "{name:22} t={threads} digest binned {:016x} bin4 {:016x}  sah binned {:.6} bin4 {:.6} bvh8 {:.6}",
+            "{name:22} t={threads} digest binned {:016x} bin4 {:016x} sbvh {:016x}  sah binned {:.6} bin4 {:.6} sbvh {:.6} bvh8 {:.6}",
             digest(&b),
             digest(&b4),
+            digest(&s),
             sah(&b),
             sah(&b4),
+            sah(&s),
             sah(&w)
         );
     });

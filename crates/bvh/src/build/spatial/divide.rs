@@ -7,27 +7,25 @@
 
 use super::bins::SpatialSplit;
 use super::chop::{corners, is_empty, split_at};
-use crate::build::{PrimRef, Ranged};
+use crate::build::PrimRef;
 use raybench_geom::TriangleMesh;
 
-/// The two children's references, and how many references the split added.
-pub(crate) struct Divided {
-    pub left: Vec<PrimRef>,
-    pub right: Vec<PrimRef>,
-    pub duplicates: usize,
-    /// Both sides' bounds, when the split measured them already (an object split: its bins'
-    /// boxes are the unions of the records' boxes), so the children need no pass over them.
-    pub measured: Option<[Ranged; 2]>,
-}
-
-/// Splits `refs` at `s`; `None` when a side would be left empty (the binning estimate and the
-/// exact cut can disagree by a rounding at the plane), and the caller keeps the object split.
-pub(crate) fn divide(refs: &[PrimRef], mesh: &TriangleMesh, s: &SpatialSplit) -> Option<Divided> {
+/// Splits `refs` at `s` into `left` and `right` (cleared first, so a task's vectors serve
+/// every node it builds) and returns how many references the split added; `None` when a side
+/// would be left empty (the binning estimate and the exact cut can disagree by a rounding at
+/// the plane), and the caller keeps the object split.
+pub(crate) fn divide(
+    refs: &[PrimRef],
+    mesh: &TriangleMesh,
+    s: &SpatialSplit,
+    left: &mut Vec<PrimRef>,
+    right: &mut Vec<PrimRef>,
+) -> Option<usize> {
     let (axis, pos) = (s.axis, s.pos);
     let (mut left_box, mut right_box) = (s.left, s.right);
     let (mut nl, mut nr) = (s.left_count as f64, s.right_count as f64);
-    let mut left = Vec::with_capacity(s.left_count);
-    let mut right = Vec::with_capacity(s.right_count);
+    left.clear();
+    right.clear();
     let mut duplicates = 0;
     for r in refs {
         let b = r.bounds();
@@ -74,12 +72,7 @@ pub(crate) fn divide(refs: &[PrimRef], mesh: &TriangleMesh, s: &SpatialSplit) ->
     if left.is_empty() || right.is_empty() {
         return None;
     }
-    Some(Divided {
-        left,
-        right,
-        duplicates,
-        measured: None,
-    })
+    Some(duplicates)
 }
 
 #[cfg(test)]
@@ -122,11 +115,12 @@ mod tests {
         let p = WideParams::default().binary;
         let mut bins = SlabBins::new();
         let s = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 64, &mut bins).expect("a plane");
-        let d = divide(&refs, &mesh, &s).expect("both sides");
-        assert_eq!(d.left.len() + d.right.len(), refs.len() + d.duplicates);
-        assert!(d.duplicates > 0 && d.duplicates <= 64);
+        let (mut left, mut right) = (Vec::new(), Vec::new());
+        let duplicates = divide(&refs, &mesh, &s, &mut left, &mut right).expect("both sides");
+        assert_eq!(left.len() + right.len(), refs.len() + duplicates);
+        assert!(duplicates > 0 && duplicates <= 64);
         // Each piece lies within its triangle's box and on its side of the plane.
-        for (side, pieces) in [(0, &d.left), (1, &d.right)] {
+        for (side, pieces) in [(0, &left), (1, &right)] {
             for r in pieces.iter() {
                 let b = r.bounds();
                 let tri = box_of(&mesh.triangle(r.id() as usize).bounds());

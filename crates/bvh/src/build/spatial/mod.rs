@@ -32,7 +32,7 @@ use crate::BvhParams;
 use crate::build::{Box3, PrimRef};
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use bins::{SlabBins, SpatialSplit, best_spatial_split};
-use divide::{Divided, divide};
+use divide::divide;
 use raybench_geom::{Aabb, TriangleMesh};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -113,25 +113,28 @@ struct Ctx<'a> {
     searches: AtomicU64,
 }
 
-/// A subtree as the spatial builder returns it, before flattening.
+/// A subtree as the spatial builder returns it, before flattening. Its references stay in
+/// the build's one array, at the positions the build gave them.
 enum Tree {
-    Leaf(Vec<PrimRef>),
+    /// A leaf of `count` references from position `at`.
+    Leaf { at: usize, count: usize },
     Node {
         bounds: [Aabb; 2],
         spatial: bool,
         children: Box<(Tree, Tree)>,
     },
-    /// A range the binned builder built, its leaves numbered from 0 within `refs`.
-    Binned {
-        part: Part,
-        refs: Vec<PrimRef>,
-    },
+    /// A range of `count` references from position `at` that the binned builder built in
+    /// place, its leaves numbered from 0 within the range.
+    Binned { part: Part, at: usize, count: usize },
 }
 
 /// Per-task working memory.
 struct Work {
     binned: Box<Scratch>,
     slabs: Box<SlabBins>,
+    /// A spatial split's two sides, before they go back into the array.
+    left: Vec<PrimRef>,
+    right: Vec<PrimRef>,
 }
 
 impl Work {
@@ -139,18 +142,30 @@ impl Work {
         Work {
             binned: Scratch::new(),
             slabs: SlabBins::new(),
+            left: Vec::new(),
+            right: Vec::new(),
         }
     }
 }
 
 /// Builds the tree of a non-empty mesh with spatial splits.
+///
+/// The references live in one array with room for the whole budget of duplicates, as in
+/// Embree's spatial-split builder: a node owns a slice of it whose front holds its references
+/// and whose rest is room for as many more as its budget allows. A split leaves each child's
+/// references at the front of the child's own slice, so nodes neither allocate nor copy into
+/// new vectors; a spatial split's pieces are written back over the node's references.
 pub(crate) fn build(mesh: &TriangleMesh, p: &BvhParams, s: &SpatialSplits) -> Flat {
     let n = mesh.len();
-    let refs: Vec<PrimRef> = (0..n)
+    let budget = (n as f64 * s.max_reference_growth.max(0.0) as f64) as usize;
+    let mut refs: Vec<PrimRef> = Vec::with_capacity(n + budget);
+    (0..n)
         .into_par_iter()
         .map(|i| PrimRef::new(&mesh.triangle(i).bounds(), i as u32))
-        .collect();
+        .collect_into_vec(&mut refs);
     let whole = Ranged::of(&refs, PARALLEL_BINNING);
+    // The room past the triangles' records: never read before a split writes it.
+    refs.resize(n + budget, PrimRef::new(&Aabb::EMPTY, 0));
     let ctx = Ctx {
         p,
         s,
@@ -162,8 +177,13 @@ pub(crate) fn build(mesh: &TriangleMesh, p: &BvhParams, s: &SpatialSplits) -> Fl
         },
         searches: AtomicU64::new(0),
     };
-    let budget = (n as f64 * s.max_reference_growth.max(0.0) as f64) as usize;
-    let tree = ctx.node(refs, whole, 0, budget, &mut Work::new());
+    let tree = ctx.node(
+        Slot::new(&mut refs, 0, n),
+        whole,
+        0,
+        budget,
+        &mut Work::new(),
+    );
     let mut out = Flat {
         nodes: Vec::with_capacity(n),
         refs: Vec::with_capacity(n),
@@ -171,31 +191,79 @@ pub(crate) fn build(mesh: &TriangleMesh, p: &BvhParams, s: &SpatialSplits) -> Fl
         root_bounds: whole.bounds.to_aabb(),
         spatial: Some(SpatialReport::default()),
     };
-    out.root = tree.flatten(&mut out);
+    out.root = tree.flatten(&refs, &mut out);
     if let Some(s) = out.spatial.as_mut() {
         s.spatial_searches = ctx.searches.into_inner();
     }
     out
 }
 
+/// A node's slice of the reference array: its `count` references at the front, room for more
+/// behind them; `at` is where the slice starts in the whole array.
+struct Slot<'a> {
+    refs: &'a mut [PrimRef],
+    at: usize,
+    count: usize,
+}
+
+impl<'a> Slot<'a> {
+    fn new(refs: &'a mut [PrimRef], at: usize, count: usize) -> Slot<'a> {
+        debug_assert!(count <= refs.len());
+        Slot { refs, at, count }
+    }
+
+    fn live(&mut self) -> &mut [PrimRef] {
+        &mut self.refs[..self.count]
+    }
+}
+
+/// Where a split leaves its children in the node's slice: the left child's references at the
+/// front, the right child's from `right_at`, each side followed by the room for its budget.
+struct Placed {
+    counts: [usize; 2],
+    budgets: [usize; 2],
+    right_at: usize,
+    /// Both sides' bounds, when the split measured them already (an object split: its bins'
+    /// boxes are the unions of the records' boxes), so the children need no pass over them.
+    measured: Option<[Ranged; 2]>,
+    spatial: bool,
+}
+
+impl Placed {
+    /// Shares the budget left after `duplicates` between the sides in proportion to their
+    /// references.
+    fn new(counts: [usize; 2], budget: usize, duplicates: usize, spatial: bool) -> Placed {
+        let [nl, nr] = counts;
+        let rest = budget.saturating_sub(duplicates);
+        let left = (rest as u128 * nl as u128 / (nl + nr) as u128) as usize;
+        Placed {
+            counts,
+            budgets: [left, rest - left],
+            right_at: nl + left,
+            measured: None,
+            spatial,
+        }
+    }
+
+    /// The slice length both sides with their room need.
+    fn needs(&self) -> usize {
+        self.right_at + self.counts[1] + self.budgets[1]
+    }
+}
+
 impl Ctx<'_> {
-    fn node(
-        &self,
-        refs: Vec<PrimRef>,
-        r: Ranged,
-        depth: usize,
-        budget: usize,
-        w: &mut Work,
-    ) -> Tree {
-        let (p, n) = (self.p, refs.len());
+    fn node(&self, mut slot: Slot, r: Ranged, depth: usize, budget: usize, w: &mut Work) -> Tree {
+        let (p, n) = (self.p, slot.count);
         if budget == 0 || r.bounds.half_area() <= self.min_overlap {
-            return self.binned(refs, r, depth, w);
+            return self.binned(slot, r, depth, w);
         }
         if n == 1 || depth + 1 >= MAX_DEPTH || leaf_beats_any_split(p, n) {
-            return Tree::Leaf(refs);
+            return Tree::Leaf {
+                at: slot.at,
+                count: n,
+            };
         }
-        let mut refs = refs;
-        let object = binned_split(&mut refs, &r, p, &mut w.binned);
+        let object = binned_split(slot.live(), &r, p, &mut w.binned);
         let parent = r.bounds.half_area();
         let q = &self.priced;
         let object_cost = object.map(|o| {
@@ -215,28 +283,37 @@ impl Ctx<'_> {
         });
         if overlap > self.min_overlap
             && overlap >= self.s.overlap_share as f64 * parent
-            && let Some(s) = self.search(&refs, &r.bounds, budget, w)
+            && let Some(s) = self.search(slot.live(), &r.bounds, budget, w)
             && object_cost.is_none_or(|c| s.cost < c)
             && worth_splitting(q, n, s.cost)
-            && let Some(d) = divide(&refs, self.mesh, &s)
+            && let Some(duplicates) = divide(slot.live(), self.mesh, &s, &mut w.left, &mut w.right)
         {
-            drop(refs);
-            return self.children(d, budget, depth, true, w);
+            let placed = Placed::new([w.left.len(), w.right.len()], budget, duplicates, true);
+            // Only a cut the binning misjudged can add more references than the budget
+            // holds room for; the object split stands in for it.
+            if placed.needs() <= slot.refs.len() {
+                let [nl, nr] = placed.counts;
+                slot.refs[..nl].copy_from_slice(&w.left);
+                slot.refs[placed.right_at..placed.right_at + nr].copy_from_slice(&w.right);
+                return self.children(slot, placed, depth, w);
+            }
         }
         let split = match object {
             Some(o) => o,
-            None if n <= p.max_leaf_size as usize => return Tree::Leaf(refs),
+            None if n <= p.max_leaf_size as usize => {
+                return Tree::Leaf {
+                    at: slot.at,
+                    count: n,
+                };
+            }
             // Centroids indistinguishable and no plane worth cutting: halves as they are.
-            None => Split::at(&refs, n / 2),
+            None => Split::at(slot.live(), n / 2),
         };
-        let right = refs.split_off(split.mid);
-        let d = Divided {
-            left: refs,
-            right,
-            duplicates: 0,
-            measured: Some([split.left, split.right]),
-        };
-        self.children(d, budget, depth, false, w)
+        let mut placed = Placed::new([split.mid, n - split.mid], budget, 0, false);
+        placed.measured = Some([split.left, split.right]);
+        // The right side moves behind the left side's room.
+        slot.refs.copy_within(split.mid..n, placed.right_at);
+        self.children(slot, placed, depth, w)
     }
 
     /// The cheapest spatial split of a node's references, counted for the report.
@@ -259,66 +336,64 @@ impl Ctx<'_> {
         )
     }
 
-    /// Builds both children of a split, sharing the budget left in proportion to their
-    /// references (on two rayon tasks above the parallel threshold).
-    fn children(
-        &self,
-        d: Divided,
-        budget: usize,
-        depth: usize,
-        spatial: bool,
-        w: &mut Work,
-    ) -> Tree {
-        let (nl, nr) = (d.left.len(), d.right.len());
-        let rest = budget.saturating_sub(d.duplicates);
-        let left_budget = (rest as u128 * nl as u128 / (nl + nr) as u128) as usize;
-        let right_budget = rest - left_budget;
-        let [left, right] = d.measured.unwrap_or_else(|| {
+    /// Builds both children of a split as `placed` left them in `slot` (on two rayon tasks
+    /// above the parallel threshold).
+    fn children(&self, slot: Slot, placed: Placed, depth: usize, w: &mut Work) -> Tree {
+        let [nl, nr] = placed.counts;
+        let (left_refs, right_refs) = slot.refs.split_at_mut(placed.right_at);
+        let [left, right] = placed.measured.unwrap_or_else(|| {
             [
-                Ranged::of(&d.left, PARALLEL_BINNING),
-                Ranged::of(&d.right, PARALLEL_BINNING),
+                Ranged::of(&left_refs[..nl], PARALLEL_BINNING),
+                Ranged::of(&right_refs[..nr], PARALLEL_BINNING),
             ]
         });
         let bounds = [left.bounds.to_aabb(), right.bounds.to_aabb()];
+        let left_slot = Slot::new(left_refs, slot.at, nl);
+        let right_slot = Slot::new(right_refs, slot.at + placed.right_at, nr);
+        let [left_budget, right_budget] = placed.budgets;
         let children = if nl + nr > self.p.parallel_threshold as usize {
             rayon::join(
-                || self.node(d.left, left, depth + 1, left_budget, w),
-                || self.node(d.right, right, depth + 1, right_budget, &mut Work::new()),
+                || self.node(left_slot, left, depth + 1, left_budget, w),
+                || self.node(right_slot, right, depth + 1, right_budget, &mut Work::new()),
             )
         } else {
-            let a = self.node(d.left, left, depth + 1, left_budget, w);
-            (a, self.node(d.right, right, depth + 1, right_budget, w))
+            let a = self.node(left_slot, left, depth + 1, left_budget, w);
+            (a, self.node(right_slot, right, depth + 1, right_budget, w))
         };
         Tree::Node {
             bounds,
-            spatial,
+            spatial: placed.spatial,
             children: Box::new(children),
         }
     }
 
-    /// The plain binned builder over `refs`, where no spatial split can be tried.
-    fn binned(&self, mut refs: Vec<PrimRef>, r: Ranged, depth: usize, w: &mut Work) -> Tree {
-        let part = if refs.len() > self.p.parallel_threshold as usize {
-            build_part(self.p, &mut refs, 0, r, depth)
+    /// The plain binned builder over a node's references, in place, where no spatial split
+    /// can be tried.
+    fn binned(&self, mut slot: Slot, r: Ranged, depth: usize, w: &mut Work) -> Tree {
+        let (at, count) = (slot.at, slot.count);
+        let refs = slot.live();
+        let part = if count > self.p.parallel_threshold as usize {
+            build_part(self.p, refs, 0, r, depth)
         } else {
             let mut nodes = Vec::new();
-            let root = build_local(self.p, &mut refs, 0, r, depth, &mut nodes, &mut w.binned);
+            let root = build_local(self.p, refs, 0, r, depth, &mut nodes, &mut w.binned);
             Part::Local { nodes, root }
         };
-        Tree::Binned { part, refs }
+        Tree::Binned { part, at, count }
     }
 }
 
 impl Tree {
-    /// Appends this subtree's nodes and references to `out` depth-first; returns its root.
-    fn flatten(self, out: &mut Flat) -> ChildRef {
+    /// Appends this subtree's nodes, and its references from `refs` (the build's array), to
+    /// `out` depth-first; returns its root.
+    fn flatten(self, refs: &[PrimRef], out: &mut Flat) -> ChildRef {
         match self {
-            Tree::Leaf(refs) => {
+            Tree::Leaf { at, count } => {
                 let r = ChildRef {
                     index: out.refs.len() as u32,
-                    count: refs.len() as u32,
+                    count: count as u32,
                 };
-                out.refs.extend(refs);
+                out.refs.extend_from_slice(&refs[at..at + count]);
                 r
             }
             Tree::Node {
@@ -335,12 +410,12 @@ impl Tree {
                     [ChildRef::default(); 2],
                 ));
                 let (a, b) = *children;
-                let a = a.flatten(out);
-                let b = b.flatten(out);
+                let a = a.flatten(refs, out);
+                let b = b.flatten(refs, out);
                 out.nodes[at].child = [a, b];
                 interior(at)
             }
-            Tree::Binned { part, refs } => {
+            Tree::Binned { part, at, count } => {
                 // The binned builder numbered its leaves from 0: shift them to where its
                 // references land.
                 let (first_node, offset) = (out.nodes.len(), out.refs.len() as u32);
@@ -353,7 +428,7 @@ impl Tree {
                 if root.is_leaf() {
                     root.index += offset;
                 }
-                out.refs.extend(refs);
+                out.refs.extend_from_slice(&refs[at..at + count]);
                 root
             }
         }
