@@ -39,6 +39,31 @@ fn wide_sbvh_conforms() {
     }
 }
 
+/// The packet walk (`bvh8-sbvh-packets`) over a tree whose leaves share triangles: the shared
+/// suite (whose coherent-batch check holds it to brute force), and on every case's rays the
+/// single-ray walk's answers but for ties. A triangle in two leaves a packet reaches is tested
+/// twice with the same answer, so duplicates change nothing a lane sees.
+#[test]
+fn packet_walk_over_split_references_conforms() {
+    for params in [WideParams::sbvh(), sbvh(2.0)] {
+        let params = WideParams {
+            coherent_packets: true,
+            ..params
+        };
+        let counts = conformance::<Bvh8>(&params, &|b, m| b.validate(m));
+        assert_eq!(counts.mismatch, 0, "{params:?}");
+        assert!(counts.exact > 10_000, "{counts:?}");
+        for case in raybench_testkit::seeded_cases()
+            .into_iter()
+            .chain(raybench_testkit::edge_cases())
+        {
+            let bvh = Bvh8::build(case.mesh.clone(), &params).expect("builds");
+            let rays = raybench_testkit::valid_rays(&case);
+            raybench_testkit::packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
+        }
+    }
+}
+
 #[test]
 fn wide_sbvh_conforms_on_the_shared_scenes() {
     let checked =

@@ -227,6 +227,15 @@ fn own_structures() -> Vec<StructureEntry> {
                 ..WideParams::for_width(8)
             },
         ),
+        register::<Bvh8>(
+            "bvh8-sbvh-packets",
+            "bvh8-sbvh's Split BVH traced as bvh8-packets traces: coherent batches (primary rays for closest hit, shadow rays for any hit) sixteen consecutive rays a packet, every other batch ray by ray (both techniques together: what they buy combined)",
+            None,
+            |_| WideParams {
+                coherent_packets: true,
+                ..WideParams::sbvh()
+            },
+        ),
         register::<Bvh8Compressed>(
             "bvh8-compressed",
             "the bvh8-binned tree (same collapse, same Tri4 leaves, same walk) with quantized nodes: per node and axis an f32 origin and a power-of-two step, each child plane one byte rounded outward, 128 bytes a node instead of 256; each plane row decoded in AVX2 registers before the same 8-lane box test",
