@@ -9,7 +9,7 @@ use super::chop::{Corners, corners, is_empty, split_estimate};
 use crate::BvhParams;
 use crate::build::split::split_cost;
 use crate::build::{Box3, PrimRef};
-use crate::simd::prefetch;
+use crate::simd::{F4, prefetch};
 use glam::Vec3A;
 use raybench_geom::TriangleMesh;
 
@@ -76,10 +76,14 @@ pub(crate) fn best_spatial_split(
     let (lo, extent) = (bounds.lo, bounds.hi - bounds.lo);
     let step = extent / nb as f32;
     let plane = |axis: usize, b: usize| lo[axis] + step[axis] * b as f32;
+    // Clamped to the slabs in floats, then one SIMD truncation for the three lanes: a
+    // saturating `as usize` per lane costs several instructions each. The same slabs: a
+    // coordinate inside the box is never below `lo`, and a lane of zero extent (0 / 0) is
+    // never read.
+    let top = Vec3A::splat((nb - 1) as f32);
     let slabs_of = |x: Vec3A| {
-        ((x - lo) / step)
-            .to_array()
-            .map(|s| (s as usize).min(nb - 1))
+        let s = F4::from_vec3a(((x - lo) / step).max(Vec3A::ZERO).min(top)).trunc_i32();
+        [s[0] as usize, s[1] as usize, s[2] as usize]
     };
     let mut live = [0, 1, 2].map(|axis| extent[axis] > 0.0);
     for axis in (0..3).filter(|&a| live[a]) {
