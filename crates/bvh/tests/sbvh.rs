@@ -58,6 +58,7 @@ fn packet_walk_over_split_references_conforms() {
             .chain(raybench_testkit::edge_cases())
         {
             let bvh = Bvh8::build(case.mesh.clone(), &params).expect("builds");
+            assert_eq!(bvh.name(), "bvh8-sbvh-packets");
             let rays = raybench_testkit::valid_rays(&case);
             raybench_testkit::packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
         }

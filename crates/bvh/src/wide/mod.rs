@@ -229,6 +229,7 @@ impl<const W: usize> Accel for BvhWide<W> {
                 "bvh8-sbvh-reinsert"
             }
             (8, false) if self.params.binary.spatial_splits.is_some() => "bvh8-sbvh",
+            (8, true) if self.params.binary.spatial_splits.is_some() => "bvh8-sbvh-packets",
             (4, _) => "bvh4-binned",
             (_, false) if self.params.binary.reinsertion.is_some() => "bvh8-reinsert",
             (_, false) => "bvh8-binned",
