@@ -30,8 +30,10 @@ use crate::build::blocks;
 use crate::node::{ChildRef, Node};
 use raybench_geom::Aabb;
 
-/// Subtrees of at least this many binary nodes plan their two children on rayon.
-const PARALLEL_PLAN: usize = 8192;
+/// Subtrees of at least this many binary nodes plan their two children on rayon: 1,024
+/// against 8,192, the bunny's and the 100k sphere's 2-thread builds 7 % faster (8,192 left the
+/// bunny's plan on one thread; see docs/experiments.md, "the plan forked from 1,024 nodes").
+const PARALLEL_PLAN: usize = 1024;
 
 /// One binary interior node's entry: for `i` = 1 to `W`, the least cost of covering it with
 /// at most `i` children (`cost[i - 1]`) and how (`cover[i - 1]`: `(0, 0)` the node alone, or
