@@ -55,11 +55,12 @@ pub struct SpatialSplits {
     pub max_reference_growth: f32,
     /// The SAH cost of a triangle test (a node step costing 1) in the choice between the object
     /// and the spatial split, and between a spatial split and a leaf; the object splits keep
-    /// the binary builder's `intersection_cost`. 1: with the wide tree's 0.15 per triangle
-    /// slot, spatial splits never divide a node the object split leaves as a leaf, and random
-    /// rays test 8.18 → 6.52 triangles on Sponza (binned → SBVH) and visit 4.66 → 3.62 nodes;
-    /// with 1, 3.86 triangles and 3.87 nodes; grass 6.49 → 7.55 tests with 0.15 but 4.68 with
-    /// 1 (nodes 4.95 → 4.92 and 5.28) (`examples/sbvh_tune`, 20,000 random rays, 2026-11-26).
+    /// the binary builder's `intersection_cost`. The higher it is, the more the small nodes the
+    /// object split leaves as leaves are cut by spatial splits into smaller leaves: more leaves
+    /// a ray visits for fewer triangle tests (the bunny: 8,379 spatial splits at 1, 1,247 at
+    /// 0.3). 0.3: against 1, the race suite's traversal within noise and its build 7 % faster;
+    /// nine generated scenes at seed 7 random rays +4 %, shadow +2.5 %, diffuse +3 %, whitted
+    /// +2 % (see docs/experiments.md, "0.3 per triangle test in the spatial split's choices").
     pub intersection_cost: f32,
     /// Slabs per axis in the spatial split's binning (at most [`MAX_SPATIAL_BINS`]). 16: on
     /// hair (50,000 triangles) the same SAH cost as 32 (7389 against 7394) in 403 ms instead of
@@ -84,7 +85,7 @@ impl Default for SpatialSplits {
             alpha: 1e-4,
             max_reference_growth: 0.5,
             spatial_bins: 16,
-            intersection_cost: 1.0,
+            intersection_cost: 0.3,
             overlap_share: 0.3,
         }
     }
