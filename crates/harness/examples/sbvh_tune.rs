@@ -54,9 +54,10 @@ fn main() {
     for c in &configs {
         let mut p = WideParams::sbvh();
         p.binary.spatial_splits = Some(*c);
+        // The five knobs in the order the configuration takes them.
         let name = format!(
-            "sbvh {},{},{},{}",
-            c.alpha, c.max_reference_growth, c.spatial_bins, c.overlap_share
+            "sbvh {},{},{},{},{}",
+            c.alpha, c.max_reference_growth, c.spatial_bins, c.intersection_cost, c.overlap_share
         );
         params.push((name, p));
     }
