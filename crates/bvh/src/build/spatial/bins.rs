@@ -117,7 +117,7 @@ pub(crate) fn best_spatial_split(
         return None;
     }
     // A node's references are in spatial order, their triangles anywhere in the mesh: each
-    // chopped reference waited on its triangle's index and vertices. They are prefetched
+    // chopped reference would wait on its triangle's index and vertices. They are prefetched
     // ahead, the index twice as far ahead as the vertices that need it.
     let (indices, positions) = (mesh.indices(), mesh.positions());
     for (i, r) in refs.iter().enumerate() {

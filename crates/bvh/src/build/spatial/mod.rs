@@ -255,6 +255,7 @@ impl Placed {
 impl Ctx<'_> {
     fn node(&self, mut slot: Slot, r: Ranged, depth: usize, budget: usize, w: &mut Work) -> Tree {
         let (p, n) = (self.p, slot.count);
+        debug_assert!(slot.refs.len() >= n + budget, "room for the budget");
         if budget == 0 || r.bounds.half_area() <= self.min_overlap {
             return self.binned(slot, r, depth, w);
         }
