@@ -9,10 +9,10 @@
 //! harness does (`Workers::start`). The device is created before the first timed build and
 //! kept alive, so no timed build pays for Embree's thread start-up.
 //!
-//! `bvh-sbvh` is the binary tree `bvh8-sbvh` is collapsed from (spatial splits at their
-//! defaults). `bvh-bin4` is the binary tree the 8-wide BVH is collapsed from (`WideParams::default()`'s
+//! `bvh-bin4` is the binary tree the 8-wide BVH is collapsed from (`WideParams::default()`'s
 //! `binary` knobs) built and flattened on its own: the difference to `bvh8` is the collapse and
-//! the `Tri4` leaves. The digests identify the trees (nodes and triangle order), to check
+//! the `Tri4` leaves; `bvh-sbvh` is the binary tree `bvh8-sbvh` is collapsed from (spatial
+//! splits at their defaults). The digests identify the trees (nodes and triangle order), to check
 //! that a builder change keeps them identical, and with any thread count.
 //!
 //! `cargo run --release -p raybench-harness --example build_time -- ../shared/scenes/stanford-bunny.obj 2 21`

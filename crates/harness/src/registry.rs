@@ -204,7 +204,7 @@ fn own_structures() -> Vec<StructureEntry> {
         ),
         register::<Bvh8>(
             "bvh8-sbvh",
-            "the bvh8-binned walk and leaves over a Split BVH (Stich et al. 2009): binned object splits weighed against spatial splits that cut triangles at one of 15 slab planes per axis (16 slabs) (chopped binning, reference unsplitting), tried where the object split's children overlap by more than 1e-4 of the root's area and priced with a triangle test at 0.3 of a node step, references capped at 1.5 × the triangles",
+            "the bvh8-binned walk and leaves over a Split BVH (Stich et al. 2009): binned object splits weighed against spatial splits that cut triangles at one of 15 slab planes per axis (16 slabs) (chopped binning, reference unsplitting), tried where the object split's children overlap by more than 1e-4 of the root's area and by at least 0.3 of the node's own, priced with a triangle test at 0.3 of a node step, references capped at 1.5 × the triangles",
             None,
             |_| WideParams::sbvh(),
         ),
