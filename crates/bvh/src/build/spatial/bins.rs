@@ -1,9 +1,11 @@
 //! The search for the best spatial split of a node: per axis, `spatial_bins` equal slabs of the
 //! node's box (not of its centroids), each reference chopped into the slabs it crosses (its
-//! triangle clipped at every slab plane, [`split_estimate`]), counting where it enters and where it
-//! leaves; then one sweep over the slab boundaries evaluates the SAH of cutting every
+//! triangle clipped at the slab planes, [`split_estimate`]), counting where it enters and where
+//! it leaves; then one sweep over the slab boundaries evaluates the SAH of cutting every
 //! reference at that plane (Stich, Friedrich and Dietrich 2009, section 4.2). A boundary whose
-//! cut would duplicate more references than the node's budget allows is not a candidate.
+//! cut would duplicate more references than the node's budget allows is not a candidate, and
+//! the counts, taken first, tell which are: a reference is clipped only at the candidate planes
+//! it crosses, since the sweep reads the slabs' boxes nowhere else.
 
 use super::chop::{Corners, corners, is_empty, split_estimate};
 use crate::BvhParams;
@@ -91,10 +93,11 @@ pub(crate) fn best_spatial_split(
         bins.enter[axis][..nb].fill(0);
         bins.exit[axis][..nb].fill(0);
     }
-    // First the counts alone: a plane duplicates the references that cross it, so an axis
-    // none of whose planes leaves both sides a reference within the budget needs no chopping
-    // (deep in the tree, where the budget left is small, that is most axes). The planes the
-    // sweep below can choose are the same either way.
+    // First the counts alone: a plane duplicates the references that cross it, so a plane
+    // that leaves a side empty or cuts more references than the budget holds is never chosen,
+    // and no reference needs cutting there (deep in the tree, where the budget left is small,
+    // that is most planes, often every plane of an axis). The planes the sweep below can
+    // choose are the same either way.
     for r in refs {
         let b = r.bounds();
         let (first, last) = (slabs_of(b.lo), slabs_of(b.hi));
@@ -103,15 +106,23 @@ pub(crate) fn best_spatial_split(
             bins.exit[axis][last[axis]] += 1;
         }
     }
-    for (axis, live) in live.iter_mut().enumerate().filter(|(_, l)| **l) {
+    // Per axis, a bit for each plane `b` (the lower face of slab `b`) that is a candidate.
+    let mut planes = [0u64; 3];
+    for axis in 0..3 {
+        if !live[axis] {
+            continue;
+        }
         let (mut entered, mut exited) = (0, 0);
-        *live = (1..nb).any(|b| {
+        for b in 1..nb {
             entered += bins.enter[axis][b - 1] as usize;
             exited += bins.exit[axis][b - 1] as usize;
             // Left: the references entering before the plane; right: those not leaving
             // before it; both: those crossing it.
-            candidate(entered, n - exited, n, budget)
-        });
+            if candidate(entered, n - exited, n, budget) {
+                planes[axis] |= 1 << b;
+            }
+        }
+        live[axis] = planes[axis] != 0;
     }
     if !live.contains(&true) {
         return None;
@@ -134,8 +145,11 @@ pub(crate) fn best_spatial_split(
         let mut tri: Option<Corners> = None;
         for axis in (0..3).filter(|&a| live[a]) {
             let (first, last) = (first[axis], last[axis]);
-            if first == last {
-                bins.boxes[axis][first] = bins.boxes[axis][first].union(&b);
+            // The candidate planes the reference crosses: `first + 1 ..= last`.
+            let above = u64::MAX.checked_shl(first as u32 + 1).unwrap_or(0);
+            let crossed = planes[axis] & above & (u64::MAX >> (63 - last));
+            if crossed == 0 {
+                bins.boxes[axis][last] = bins.boxes[axis][last].union(&b);
                 continue;
             }
             let tri = tri.get_or_insert_with(|| corners(&mesh.triangle(r.id() as usize)));
@@ -143,7 +157,8 @@ pub(crate) fn best_spatial_split(
                 tri,
                 axis,
                 b,
-                first..=last,
+                crossed,
+                last,
                 &|b: usize| plane(axis, b),
                 &mut bins.boxes[axis],
             );
@@ -194,22 +209,28 @@ fn candidate(lc: usize, rc: usize, n: usize, budget: usize) -> bool {
     lc > 0 && rc > 0 && lc + rc - n <= budget
 }
 
-/// Adds the pieces of one reference (box `b`, triangle `tri`) to the slabs `range` it spans
-/// on `axis`, cutting it at each plane between them in turn.
+/// Adds the pieces of one reference (box `b`, triangle `tri`, last slab `last`) to the slabs
+/// on `axis`, cut only at the candidate planes it crosses (bits of `crossed`): the piece below
+/// candidate plane `c` goes to slab `c - 1`, the rest to slab `last`. The sweep reads the boxes
+/// only at candidate planes, and there each side's union is the same as if the reference were
+/// cut at every slab plane; a reference crossing planes that cannot be chosen is cut fewer
+/// times (with a small budget, most of them), and one crossing none needs no triangle.
 fn chop_into_slabs(
     tri: &Corners,
     axis: usize,
     b: Box3,
-    range: std::ops::RangeInclusive<usize>,
+    mut crossed: u64,
+    last: usize,
     plane: &impl Fn(usize) -> f32,
     boxes: &mut [Box3; MAX_SPATIAL_BINS],
 ) {
-    let (first, last) = (*range.start(), *range.end());
     let mut rest = b;
-    for (s, slab) in boxes.iter_mut().enumerate().take(last).skip(first) {
-        let (piece, beyond) = split_estimate(tri, axis, plane(s + 1), &rest);
+    while crossed != 0 {
+        let c = crossed.trailing_zeros() as usize;
+        crossed &= crossed - 1;
+        let (piece, beyond) = split_estimate(tri, axis, plane(c), &rest);
         if !is_empty(&piece) {
-            *slab = slab.union(&piece);
+            boxes[c - 1] = boxes[c - 1].union(&piece);
         }
         if is_empty(&beyond) {
             return;
@@ -268,5 +289,58 @@ mod tests {
         assert_eq!(s.left_count + s.right_count - refs.len(), 3);
         assert!(s.pos > 0.1 && s.pos < 0.9, "{s:?}");
         assert!(best_spatial_split(&refs, &mesh, &bounds, &p, 16, 2, &mut bins).is_none());
+    }
+
+    /// With a budget that leaves only some planes as candidates, the references are cut only
+    /// at those; the chosen plane's boxes and counts must still be those of cutting every
+    /// reference at it. Checked against each reference cut once at the plane, on scenes whose
+    /// references cross many slabs, for several budgets.
+    #[test]
+    fn cutting_only_at_candidate_planes_gives_the_boxes_of_the_plane() {
+        let p = WideParams::default().binary;
+        let mut bins = SlabBins::new();
+        for spec in ["hair:triangles=2000", "soup:triangles=2000", "grass"] {
+            let mesh = raybench_testkit::generated(spec, 3);
+            let refs: Vec<PrimRef> = (0..mesh.len())
+                .map(|i| PrimRef::new(&mesh.triangle(i).bounds(), i as u32))
+                .collect();
+            let bounds = box_of(&mesh.bounds());
+            let mut found = 0;
+            for budget in [1, 5, 40, 300, refs.len()] {
+                let Some(s) = best_spatial_split(&refs, &mesh, &bounds, &p, 16, budget, &mut bins)
+                else {
+                    continue;
+                };
+                found += 1;
+                let (mut left, mut right) = (Box3::EMPTY, Box3::EMPTY);
+                let (mut nl, mut nr) = (0, 0);
+                for r in &refs {
+                    let b = r.bounds();
+                    let tri = corners(&mesh.triangle(r.id() as usize));
+                    let (l, rt) = split_estimate(&tri, s.axis, s.pos, &b);
+                    // The binning's counts: a reference whose box starts below the plane's slab
+                    // is on the left, one whose box ends in or above it on the right.
+                    if b.lo[s.axis] < s.pos && !is_empty(&l) {
+                        left = left.union(&l);
+                    }
+                    if b.hi[s.axis] >= s.pos && !is_empty(&rt) {
+                        right = right.union(&rt);
+                    }
+                    nl += usize::from(b.lo[s.axis] < s.pos);
+                    nr += usize::from(b.hi[s.axis] >= s.pos);
+                }
+                assert_eq!((s.left_count, s.right_count), (nl, nr), "{spec} {budget}");
+                assert!(s.left_count + s.right_count - refs.len() <= budget);
+                for (got, want) in [(s.left, left), (s.right, right)] {
+                    let scale = (bounds.hi - bounds.lo).max_element();
+                    let off = (got.lo - want.lo).abs().max((got.hi - want.hi).abs());
+                    assert!(
+                        off.max_element() <= 1e-5 * scale,
+                        "{spec} {budget}: {got:?} {want:?}"
+                    );
+                }
+            }
+            assert!(found >= 2, "{spec}: a plane for at least two budgets");
+        }
     }
 }
