@@ -5,7 +5,9 @@
 //! reference at that plane (Stich, Friedrich and Dietrich 2009, section 4.2). A boundary whose
 //! cut would duplicate more references than the node's budget allows is not a candidate, and
 //! the counts, taken first, tell which are: a reference is clipped only at the candidate planes
-//! it crosses, since the sweep reads the slabs' boxes nowhere else.
+//! it crosses, since the sweep reads the slabs' boxes nowhere else. Nor is a plane a candidate
+//! when, with only the references inside one slab in the boxes, its cost already reaches the
+//! object split's: chopping only grows the boxes.
 
 use super::chop::{Corners, corners, is_empty, split_estimate};
 use crate::BvhParams;
@@ -55,7 +57,10 @@ impl SlabBins {
 /// The cheapest spatial split of `refs` (whose box is `bounds`) duplicating at most `budget`
 /// references; `None` when the box is flat or no plane leaves both sides a reference within
 /// the budget. Ties go to the first axis and the leftmost plane, so the result depends on the
-/// references alone.
+/// references alone. With `beat` (the cost the split must undercut to be taken), planes that
+/// cannot cost less are not searched: the answer is then the same whenever some plane costs
+/// less than `beat`, and otherwise a plane no cheaper than `beat`, or `None`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn best_spatial_split(
     refs: &[PrimRef],
     mesh: &TriangleMesh,
@@ -63,6 +68,7 @@ pub(crate) fn best_spatial_split(
     p: &BvhParams,
     slabs: usize,
     budget: usize,
+    beat: Option<f64>,
     bins: &mut SlabBins,
 ) -> Option<SpatialSplit> {
     let parent = bounds.half_area();
@@ -98,12 +104,16 @@ pub(crate) fn best_spatial_split(
     // and no reference needs cutting there (deep in the tree, where the budget left is small,
     // that is most planes, often every plane of an axis). The planes the sweep below can
     // choose are the same either way.
+    // A reference inside one slab goes into it whole, here, and the chopping skips it.
     for r in refs {
         let b = r.bounds();
         let (first, last) = (slabs_of(b.lo), slabs_of(b.hi));
         for axis in (0..3).filter(|&a| live[a]) {
             bins.enter[axis][first[axis]] += 1;
             bins.exit[axis][last[axis]] += 1;
+            if first[axis] == last[axis] {
+                bins.boxes[axis][first[axis]] = bins.boxes[axis][first[axis]].union(&b);
+            }
         }
     }
     // Per axis, a bit for each plane `b` (the lower face of slab `b`) that is a candidate.
@@ -121,6 +131,9 @@ pub(crate) fn best_spatial_split(
             if candidate(entered, n - exited, n, budget) {
                 planes[axis] |= 1 << b;
             }
+        }
+        if let Some(beat) = beat {
+            planes[axis] &= below(p, parent, bins, axis, nb, n, planes[axis], beat);
         }
         live[axis] = planes[axis] != 0;
     }
@@ -145,6 +158,9 @@ pub(crate) fn best_spatial_split(
         let mut tri: Option<Corners> = None;
         for axis in (0..3).filter(|&a| live[a]) {
             let (first, last) = (first[axis], last[axis]);
+            if first == last {
+                continue;
+            }
             // The candidate planes the reference crosses: `first + 1 ..= last`.
             let above = u64::MAX.checked_shl(first as u32 + 1).unwrap_or(0);
             let crossed = planes[axis] & above & (u64::MAX >> (63 - last));
@@ -178,7 +194,7 @@ pub(crate) fn best_spatial_split(
             left_count += enter[b - 1];
             let (right, right_count) = bins.right[b];
             let (lc, rc) = (left_count as usize, right_count as usize);
-            if !candidate(lc, rc, n, budget) {
+            if planes[axis] & 1 << b == 0 {
                 continue;
             }
             let cost = split_cost(p, parent, (left.half_area(), lc), (right.half_area(), rc));
@@ -201,6 +217,47 @@ pub(crate) fn best_spatial_split(
 /// References ahead of the chopping whose vertices are prefetched (not tuned: 8 was the first
 /// value tried, see docs/experiments.md).
 const AHEAD: usize = 8;
+
+/// Of the planes in `planes` on `axis`, those whose cost may lie below `beat`: a plane's cost
+/// is at least that of sides holding only the references inside one slab (the slabs' boxes
+/// after the counting pass) with the sides' full counts, since the pieces the chopping adds
+/// only grow the boxes. The cost grows with the areas (and rounding keeps that order), so a
+/// plane dropped here costs no less than `beat` once chopped either.
+fn below(
+    p: &BvhParams,
+    parent: f64,
+    bins: &mut SlabBins,
+    axis: usize,
+    nb: usize,
+    n: usize,
+    planes: u64,
+    beat: f64,
+) -> u64 {
+    let (boxes, enter, exit) = (&bins.boxes[axis], &bins.enter[axis], &bins.exit[axis]);
+    let (mut acc, mut count) = (Box3::EMPTY, 0u32);
+    for b in (1..nb).rev() {
+        acc = acc.union(&boxes[b]);
+        count += exit[b];
+        bins.right[b] = (acc, count);
+    }
+    let (mut left, mut left_count) = (Box3::EMPTY, 0u32);
+    let mut kept = 0;
+    for b in 1..nb {
+        left = left.union(&boxes[b - 1]);
+        left_count += enter[b - 1];
+        if planes & 1 << b == 0 {
+            continue;
+        }
+        let (right, right_count) = bins.right[b];
+        let (lc, rc) = (left_count as usize, right_count as usize);
+        debug_assert!(lc + rc >= n);
+        let area = |x: &Box3| if is_empty(x) { 0.0 } else { x.half_area() };
+        if split_cost(p, parent, (area(&left), lc), (area(&right), rc)) < beat {
+            kept |= 1 << b;
+        }
+    }
+    kept
+}
 
 /// Whether a plane with `lc` references on its left and `rc` on its right (those crossing it
 /// on both) is a candidate: both sides hold one, and the crossings fit the budget.
@@ -283,12 +340,12 @@ mod tests {
         let bounds = box_of(&mesh.bounds());
         let p = WideParams::default().binary;
         let mut bins = SlabBins::new();
-        let s = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 3, &mut bins)
+        let s = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 3, None, &mut bins)
             .expect("a plane within a budget of three");
         assert_eq!(s.axis, 0);
         assert_eq!(s.left_count + s.right_count - refs.len(), 3);
         assert!(s.pos > 0.1 && s.pos < 0.9, "{s:?}");
-        assert!(best_spatial_split(&refs, &mesh, &bounds, &p, 16, 2, &mut bins).is_none());
+        assert!(best_spatial_split(&refs, &mesh, &bounds, &p, 16, 2, None, &mut bins).is_none());
     }
 
     /// With a budget that leaves only some planes as candidates, the references are cut only
@@ -307,7 +364,8 @@ mod tests {
             let bounds = box_of(&mesh.bounds());
             let mut found = 0;
             for budget in [1, 5, 40, 300, refs.len()] {
-                let Some(s) = best_spatial_split(&refs, &mesh, &bounds, &p, 16, budget, &mut bins)
+                let Some(s) =
+                    best_spatial_split(&refs, &mesh, &bounds, &p, 16, budget, None, &mut bins)
                 else {
                     continue;
                 };
@@ -342,5 +400,55 @@ mod tests {
             }
             assert!(found >= 2, "{spec}: a plane for at least two budgets");
         }
+    }
+
+    /// With a cost to beat, the planes that cannot undercut it are not searched: when the best
+    /// plane undercuts it, the answer is that plane, bit for bit; otherwise no answer undercuts
+    /// it either.
+    #[test]
+    fn a_cost_to_beat_leaves_the_winning_plane_alone() {
+        let p = WideParams::default().binary;
+        let mut bins = SlabBins::new();
+        let mut same = 0;
+        for spec in [
+            "hair:triangles=2000",
+            "soup:triangles=2000",
+            "grass",
+            "city",
+        ] {
+            let mesh = raybench_testkit::generated(spec, 5);
+            let refs: Vec<PrimRef> = (0..mesh.len())
+                .map(|i| PrimRef::new(&mesh.triangle(i).bounds(), i as u32))
+                .collect();
+            let bounds = box_of(&mesh.bounds());
+            for budget in [1, 3, 10, 40, 200, refs.len()] {
+                let search = |beat, bins: &mut SlabBins| {
+                    best_spatial_split(&refs, &mesh, &bounds, &p, 16, budget, beat, bins)
+                };
+                let Some(full) = search(None, &mut bins) else {
+                    continue;
+                };
+                for factor in [1.0001, 1.05, 1.0, 0.98, 0.5] {
+                    let beat = full.cost * factor;
+                    let pruned = search(Some(beat), &mut bins);
+                    if full.cost < beat {
+                        let s = pruned.expect("the winning plane is kept");
+                        assert_eq!((s.axis, s.pos, s.cost), (full.axis, full.pos, full.cost));
+                        assert_eq!((s.left, s.right), (full.left, full.right));
+                        assert_eq!(
+                            (s.left_count, s.right_count),
+                            (full.left_count, full.right_count)
+                        );
+                        same += 1;
+                    } else {
+                        assert!(
+                            pruned.is_none_or(|s| s.cost >= beat),
+                            "{spec} {budget} {factor}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(same >= 10, "{same} cases where the best plane wins");
     }
 }

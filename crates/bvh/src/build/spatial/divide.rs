@@ -114,7 +114,8 @@ mod tests {
         let bounds = box_of(&mesh.bounds());
         let p = WideParams::default().binary;
         let mut bins = SlabBins::new();
-        let s = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 64, &mut bins).expect("a plane");
+        let s = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 64, None, &mut bins)
+            .expect("a plane");
         let (mut left, mut right) = (Vec::new(), Vec::new());
         let duplicates = divide(&refs, &mesh, &s, &mut left, &mut right).expect("both sides");
         assert_eq!(left.len() + right.len(), refs.len() + duplicates);
@@ -133,7 +134,7 @@ mod tests {
             }
         }
         // No budget: no plane that cuts a reference is a candidate.
-        let none = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 0, &mut bins);
+        let none = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 0, None, &mut bins);
         assert!(none.is_none_or(|s| s.left_count + s.right_count == refs.len()));
     }
 }

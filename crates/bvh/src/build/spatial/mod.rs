@@ -285,7 +285,7 @@ impl Ctx<'_> {
         });
         if overlap > self.min_overlap
             && overlap >= self.s.overlap_share as f64 * parent
-            && let Some(s) = self.search(slot.live(), &r.bounds, budget, w)
+            && let Some(s) = self.search(slot.live(), &r.bounds, budget, object_cost, w)
             && object_cost.is_none_or(|c| s.cost < c)
             && worth_splitting(q, n, s.cost)
             && let Some(duplicates) = divide(slot.live(), self.mesh, &s, &mut w.left, &mut w.right)
@@ -324,6 +324,7 @@ impl Ctx<'_> {
         refs: &[PrimRef],
         bounds: &Box3,
         budget: usize,
+        beat: Option<f64>,
         w: &mut Work,
     ) -> Option<SpatialSplit> {
         self.searches.fetch_add(1, Ordering::Relaxed);
@@ -334,6 +335,7 @@ impl Ctx<'_> {
             &self.priced,
             self.s.spatial_bins as usize,
             budget,
+            beat,
             &mut w.slabs,
         )
     }
