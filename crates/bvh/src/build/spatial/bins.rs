@@ -54,23 +54,34 @@ impl SlabBins {
     }
 }
 
-/// The cheapest spatial split of `refs` (whose box is `bounds`) duplicating at most `budget`
-/// references; `None` when the box is flat or no plane leaves both sides a reference within
-/// the budget. Ties go to the first axis and the leftmost plane, so the result depends on the
-/// references alone. With `beat` (the cost the split must undercut to be taken), planes that
-/// cannot cost less are not searched: the answer is then the same whenever some plane costs
-/// less than `beat`, and otherwise a plane no cheaper than `beat`, or `None`.
-#[allow(clippy::too_many_arguments)]
+/// What a search may choose: `slabs` per axis, at most `budget` references duplicated, and,
+/// when `beat` is given, only a plane that may cost less (the cost the split must undercut to
+/// be taken).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Limits {
+    pub slabs: usize,
+    pub budget: usize,
+    pub beat: Option<f64>,
+}
+
+/// The cheapest spatial split of `refs` (whose box is `bounds`) within `limits`; `None` when
+/// the box is flat or no plane leaves both sides a reference within the budget. Ties go to the
+/// first axis and the leftmost plane, so the result depends on the references alone. Planes
+/// that cannot undercut `limits.beat` are not searched: the answer is then the same whenever
+/// some plane costs less than `beat`, and otherwise a plane no cheaper than `beat`, or `None`.
 pub(crate) fn best_spatial_split(
     refs: &[PrimRef],
     mesh: &TriangleMesh,
     bounds: &Box3,
     p: &BvhParams,
-    slabs: usize,
-    budget: usize,
-    beat: Option<f64>,
+    limits: Limits,
     bins: &mut SlabBins,
 ) -> Option<SpatialSplit> {
+    let Limits {
+        slabs,
+        budget,
+        beat,
+    } = limits;
     let parent = bounds.half_area();
     if parent <= 0.0 {
         return None;
@@ -102,9 +113,8 @@ pub(crate) fn best_spatial_split(
     // First the counts alone: a plane duplicates the references that cross it, so a plane
     // that leaves a side empty or cuts more references than the budget holds is never chosen,
     // and no reference needs cutting there (deep in the tree, where the budget left is small,
-    // that is most planes, often every plane of an axis). The planes the sweep below can
-    // choose are the same either way.
-    // A reference inside one slab goes into it whole, here, and the chopping skips it.
+    // that is most planes, often every plane of an axis). A reference inside one slab goes
+    // into it whole, here, and the chopping skips it.
     for r in refs {
         let b = r.bounds();
         let (first, last) = (slabs_of(b.lo), slabs_of(b.hi));
@@ -298,11 +308,20 @@ fn chop_into_slabs(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::WideParams;
     use crate::build::spatial::chop::box_of;
     use raybench_geom::Vec3;
+
+    /// 16 slabs, as the builder's default.
+    pub(crate) fn limits(budget: usize, beat: Option<f64>) -> Limits {
+        Limits {
+            slabs: 16,
+            budget,
+            beat,
+        }
+    }
 
     /// Slanted triangles each spanning the whole box in y and z (so every plane on those axes
     /// cuts them all): ten narrow ones near x = 0, ten near x = 1, and three spanning x too.
@@ -340,12 +359,14 @@ mod tests {
         let bounds = box_of(&mesh.bounds());
         let p = WideParams::default().binary;
         let mut bins = SlabBins::new();
-        let s = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 3, None, &mut bins)
+        let s = best_spatial_split(&refs, &mesh, &bounds, &p, limits(3, None), &mut bins)
             .expect("a plane within a budget of three");
         assert_eq!(s.axis, 0);
         assert_eq!(s.left_count + s.right_count - refs.len(), 3);
         assert!(s.pos > 0.1 && s.pos < 0.9, "{s:?}");
-        assert!(best_spatial_split(&refs, &mesh, &bounds, &p, 16, 2, None, &mut bins).is_none());
+        assert!(
+            best_spatial_split(&refs, &mesh, &bounds, &p, limits(2, None), &mut bins).is_none()
+        );
     }
 
     /// With a budget that leaves only some planes as candidates, the references are cut only
@@ -365,7 +386,7 @@ mod tests {
             let mut found = 0;
             for budget in [1, 5, 40, 300, refs.len()] {
                 let Some(s) =
-                    best_spatial_split(&refs, &mesh, &bounds, &p, 16, budget, None, &mut bins)
+                    best_spatial_split(&refs, &mesh, &bounds, &p, limits(budget, None), &mut bins)
                 else {
                     continue;
                 };
@@ -423,7 +444,7 @@ mod tests {
             let bounds = box_of(&mesh.bounds());
             for budget in [1, 3, 10, 40, 200, refs.len()] {
                 let search = |beat, bins: &mut SlabBins| {
-                    best_spatial_split(&refs, &mesh, &bounds, &p, 16, budget, beat, bins)
+                    best_spatial_split(&refs, &mesh, &bounds, &p, limits(budget, beat), bins)
                 };
                 let Some(full) = search(None, &mut bins) else {
                     continue;

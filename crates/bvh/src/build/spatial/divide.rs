@@ -79,6 +79,7 @@ pub(crate) fn divide(
 mod tests {
     use super::*;
     use crate::WideParams;
+    use crate::build::spatial::bins::tests::limits;
     use crate::build::spatial::bins::{SlabBins, best_spatial_split};
     use crate::build::spatial::chop::box_of;
     use raybench_geom::Vec3;
@@ -114,7 +115,7 @@ mod tests {
         let bounds = box_of(&mesh.bounds());
         let p = WideParams::default().binary;
         let mut bins = SlabBins::new();
-        let s = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 64, None, &mut bins)
+        let s = best_spatial_split(&refs, &mesh, &bounds, &p, limits(64, None), &mut bins)
             .expect("a plane");
         let (mut left, mut right) = (Vec::new(), Vec::new());
         let duplicates = divide(&refs, &mesh, &s, &mut left, &mut right).expect("both sides");
@@ -134,7 +135,7 @@ mod tests {
             }
         }
         // No budget: no plane that cuts a reference is a candidate.
-        let none = best_spatial_split(&refs, &mesh, &bounds, &p, 16, 0, None, &mut bins);
+        let none = best_spatial_split(&refs, &mesh, &bounds, &p, limits(0, None), &mut bins);
         assert!(none.is_none_or(|s| s.left_count + s.right_count == refs.len()));
     }
 }

@@ -31,7 +31,7 @@ use super::{Flat, Part, Ranged, build_local, build_part, interior};
 use crate::BvhParams;
 use crate::build::{Box3, PrimRef};
 use crate::node::{ChildRef, MAX_DEPTH, Node};
-use bins::{SlabBins, SpatialSplit, best_spatial_split};
+use bins::{Limits, SlabBins, SpatialSplit, best_spatial_split};
 use divide::divide;
 use raybench_geom::{Aabb, TriangleMesh};
 use rayon::prelude::*;
@@ -328,16 +328,12 @@ impl Ctx<'_> {
         w: &mut Work,
     ) -> Option<SpatialSplit> {
         self.searches.fetch_add(1, Ordering::Relaxed);
-        best_spatial_split(
-            refs,
-            self.mesh,
-            bounds,
-            &self.priced,
-            self.s.spatial_bins as usize,
+        let limits = Limits {
+            slabs: self.s.spatial_bins as usize,
             budget,
             beat,
-            &mut w.slabs,
-        )
+        };
+        best_spatial_split(refs, self.mesh, bounds, &self.priced, limits, &mut w.slabs)
     }
 
     /// Builds both children of a split as `placed` left them in `slot` (on two rayon tasks
