@@ -143,7 +143,7 @@ pub(crate) fn best_spatial_split(
             }
         }
         if let Some(beat) = beat {
-            planes[axis] &= below(p, parent, bins, axis, nb, n, planes[axis], beat);
+            planes[axis] &= below(p, parent, bins, axis, nb, planes[axis], beat);
         }
         live[axis] = planes[axis] != 0;
     }
@@ -239,7 +239,6 @@ fn below(
     bins: &mut SlabBins,
     axis: usize,
     nb: usize,
-    n: usize,
     planes: u64,
     beat: f64,
 ) -> u64 {
@@ -260,7 +259,6 @@ fn below(
         }
         let (right, right_count) = bins.right[b];
         let (lc, rc) = (left_count as usize, right_count as usize);
-        debug_assert!(lc + rc >= n);
         let area = |x: &Box3| if is_empty(x) { 0.0 } else { x.half_area() };
         if split_cost(p, parent, (area(&left), lc), (area(&right), rc)) < beat {
             kept |= 1 << b;
