@@ -191,37 +191,62 @@ pub(crate) fn best_spatial_split(
         }
     }
     for axis in (0..3).filter(|&a| live[a]) {
-        let (boxes, enter, exit) = (&bins.boxes[axis], &bins.enter[axis], &bins.exit[axis]);
-        let (mut acc, mut count) = (Box3::EMPTY, 0u32);
-        for b in (1..nb).rev() {
-            acc = acc.union(&boxes[b]);
-            count += exit[b];
-            bins.right[b] = (acc, count);
-        }
-        let (mut left, mut left_count) = (Box3::EMPTY, 0u32);
-        for b in 1..nb {
-            left = left.union(&boxes[b - 1]);
-            left_count += enter[b - 1];
-            let (right, right_count) = bins.right[b];
-            let (lc, rc) = (left_count as usize, right_count as usize);
-            if planes[axis] & 1 << b == 0 {
-                continue;
-            }
-            let cost = split_cost(p, parent, (left.half_area(), lc), (right.half_area(), rc));
-            if best.is_none_or(|s| cost < s.cost) {
-                best = Some(SpatialSplit {
-                    axis,
-                    pos: plane(axis, b),
-                    cost,
-                    left,
-                    right,
-                    left_count: lc,
-                    right_count: rc,
-                });
-            }
-        }
+        each_plane(
+            bins,
+            axis,
+            nb,
+            planes[axis],
+            |b, (left, lc), (right, rc)| {
+                let cost = split_cost(p, parent, (left.half_area(), lc), (right.half_area(), rc));
+                if best.is_none_or(|s| cost < s.cost) {
+                    best = Some(SpatialSplit {
+                        axis,
+                        pos: plane(axis, b),
+                        cost,
+                        left,
+                        right,
+                        left_count: lc,
+                        right_count: rc,
+                    });
+                }
+            },
+        );
     }
     best
+}
+
+/// Calls `f` with each plane `b` of `planes` on `axis`, in order, and the box and reference
+/// count of either side of it: the unions of the slabs' boxes below and above the plane, the
+/// references entering below it and those not leaving below it.
+#[inline(always)]
+fn each_plane(
+    bins: &mut SlabBins,
+    axis: usize,
+    nb: usize,
+    planes: u64,
+    mut f: impl FnMut(usize, (Box3, usize), (Box3, usize)),
+) {
+    let (boxes, enter, exit) = (&bins.boxes[axis], &bins.enter[axis], &bins.exit[axis]);
+    let (mut acc, mut count) = (Box3::EMPTY, 0u32);
+    for b in (1..nb).rev() {
+        acc = acc.union(&boxes[b]);
+        count += exit[b];
+        bins.right[b] = (acc, count);
+    }
+    let (mut left, mut left_count) = (Box3::EMPTY, 0u32);
+    for b in 1..nb {
+        left = left.union(&boxes[b - 1]);
+        left_count += enter[b - 1];
+        if planes & 1 << b == 0 {
+            continue;
+        }
+        let (right, right_count) = bins.right[b];
+        f(
+            b,
+            (left, left_count as usize),
+            (right, right_count as usize),
+        );
+    }
 }
 
 /// References ahead of the chopping whose vertices are prefetched (not tuned: 8 was the first
@@ -242,28 +267,14 @@ fn below(
     planes: u64,
     beat: f64,
 ) -> u64 {
-    let (boxes, enter, exit) = (&bins.boxes[axis], &bins.enter[axis], &bins.exit[axis]);
-    let (mut acc, mut count) = (Box3::EMPTY, 0u32);
-    for b in (1..nb).rev() {
-        acc = acc.union(&boxes[b]);
-        count += exit[b];
-        bins.right[b] = (acc, count);
-    }
-    let (mut left, mut left_count) = (Box3::EMPTY, 0u32);
+    // A side may hold no reference inside one slab: its box is then empty, of area 0.
+    let area = |x: &Box3| if is_empty(x) { 0.0 } else { x.half_area() };
     let mut kept = 0;
-    for b in 1..nb {
-        left = left.union(&boxes[b - 1]);
-        left_count += enter[b - 1];
-        if planes & 1 << b == 0 {
-            continue;
-        }
-        let (right, right_count) = bins.right[b];
-        let (lc, rc) = (left_count as usize, right_count as usize);
-        let area = |x: &Box3| if is_empty(x) { 0.0 } else { x.half_area() };
+    each_plane(bins, axis, nb, planes, |b, (left, lc), (right, rc)| {
         if split_cost(p, parent, (area(&left), lc), (area(&right), rc)) < beat {
             kept |= 1 << b;
         }
-    }
+    });
     kept
 }
 
