@@ -53,13 +53,6 @@ pub struct EmbreeParams {
     /// through `rtcIntersect1`/`rtcOccluded1`, hint or not.
     #[serde(default)]
     pub coherent_stream: bool,
-    /// Closest-hit batches not prepared as coherent (random, diffuse and Whitted rays) go
-    /// through `rtcIntersect1M` without the coherent flag, 64 rays a call, so Embree may group
-    /// them as it sees fit: the same batch that `bvh8-packets` searches for packets of its own
-    /// (its `cone_packets`). Off, they go through `rtcIntersect1`. Written into reports only
-    /// when set.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub incoherent_stream: bool,
     /// Batches prepared as coherent are traced through Embree's packet API,
     /// `rtcIntersect16`/`rtcOccluded16` with `RTC_INTERSECT_CONTEXT_FLAG_COHERENT`, sixteen
     /// consecutive rays a packet (the packets `bvh8-packets` walks), laid out outside timing;
@@ -96,13 +89,10 @@ impl EmbreeParams {
         }
     }
 
-    /// Medium quality, closest-hit batches through Embree's stream API, with the coherent flag
-    /// when the batch is coherent (`coherent_stream`) and without it otherwise
-    /// (`incoherent_stream`).
+    /// Medium quality, coherent batches through Embree's stream API (`coherent_stream`).
     pub fn medium_stream() -> EmbreeParams {
         EmbreeParams {
             coherent_stream: true,
-            incoherent_stream: true,
             ..EmbreeParams::default()
         }
     }

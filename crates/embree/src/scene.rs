@@ -165,10 +165,9 @@ impl EmbreeScene {
 const STREAM: usize = 64;
 
 impl EmbreeScene {
-    /// A batch through Embree's stream API, [`STREAM`] rays a call, with the coherent flag when
-    /// `coherent`: the checked rays are copied to a local array (the call writes its answers
-    /// into the rays).
-    fn intersect_stream(&self, batch: &[ValidRay], coherent: bool, out: &mut [Option<Hit>]) {
+    /// A coherent batch through Embree's stream API, [`STREAM`] rays a call: the checked rays
+    /// are copied to a local array (the call writes its answers into the rays).
+    fn intersect_stream(&self, batch: &[ValidRay], out: &mut [Option<Hit>]) {
         let Some(first) = batch.first() else {
             return;
         };
@@ -177,15 +176,11 @@ impl EmbreeScene {
             for (s, r) in stream.iter_mut().zip(rays) {
                 *s = r.ray_hit();
             }
-            let mut context = if coherent {
-                coherent_context()
-            } else {
-                intersect_context()
-            };
+            let mut context = coherent_context();
             // SAFETY: the scene is committed and alive; `stream` holds `rays.len()` (at most
             // STREAM) 16-byte-aligned RTCRayHits, each built from a ray that passed
             // `Ray::check`, laid out `size_of::<RTCRayHit>()` bytes apart; `context` is
-            // initialised as rtcInitIntersectContext does, with or without the coherent flag.
+            // initialised as rtcInitIntersectContext does, with the coherent flag.
             unsafe {
                 sys::rtcIntersect1M(
                     self.scene.0,
@@ -403,10 +398,7 @@ impl Accel for EmbreeScene {
         }
         let batch = prepared.slice(first, out.len());
         if prepared.is_coherent() {
-            return self.intersect_stream(batch, true, out);
-        }
-        if self.params.incoherent_stream {
-            return self.intersect_stream(batch, false, out);
+            return self.intersect_stream(batch, out);
         }
         for (o, &ray) in out.iter_mut().zip(batch) {
             *o = self.intersect_valid(ray);

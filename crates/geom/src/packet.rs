@@ -66,29 +66,28 @@ pub struct RayPackets {
     len: usize,
 }
 
-impl RayBlock {
-    /// Up to [`PACKET`] rays (at least one), lane by lane; lanes past the end copy the last ray.
-    pub fn new(rays: &[Ray]) -> RayBlock {
-        let mut rows = [[0.0f32; PACKET]; 11];
-        for lane in 0..PACKET {
-            let ray = &rays[lane.min(rays.len() - 1)];
-            let (o, d, inv) = (ray.origin(), ray.dir(), ray.inv_dir());
-            for a in 0..3 {
-                rows[a][lane] = o[a];
-                rows[3 + a][lane] = d[a];
-                rows[6 + a][lane] = inv[a];
-            }
-            rows[9][lane] = ray.t_min();
-            rows[10][lane] = ray.t_max();
-        }
-        RayBlock { rows }
-    }
-}
-
 impl RayPackets {
     pub fn new(rays: &[Ray]) -> RayPackets {
+        let blocks = rays
+            .chunks(PACKET)
+            .map(|chunk| {
+                let mut rows = [[0.0f32; PACKET]; 11];
+                for lane in 0..PACKET {
+                    let ray = &chunk[lane.min(chunk.len() - 1)];
+                    let (o, d, inv) = (ray.origin(), ray.dir(), ray.inv_dir());
+                    for a in 0..3 {
+                        rows[a][lane] = o[a];
+                        rows[3 + a][lane] = d[a];
+                        rows[6 + a][lane] = inv[a];
+                    }
+                    rows[9][lane] = ray.t_min();
+                    rows[10][lane] = ray.t_max();
+                }
+                RayBlock { rows }
+            })
+            .collect();
         RayPackets {
-            blocks: rays.chunks(PACKET).map(RayBlock::new).collect(),
+            blocks,
             len: rays.len(),
         }
     }

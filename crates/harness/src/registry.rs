@@ -220,15 +220,21 @@ fn own_structures() -> Vec<StructureEntry> {
         ),
         register::<Bvh8>(
             "bvh8-packets",
-            "the bvh8-binned tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane; in every other batch, each run of sixteen consecutive rays within a 5.7-degree cone in one octant as a packet, the rest ray by ray as bvh8-binned",
+            "the bvh8-binned tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane, every other batch ray by ray as bvh8-binned",
             None,
-            |_| WideParams::for_width(8).with_packets(),
+            |_| WideParams {
+                coherent_packets: true,
+                ..WideParams::for_width(8)
+            },
         ),
         register::<Bvh8>(
             "bvh8-sbvh-packets",
-            "bvh8-sbvh's Split BVH traced as bvh8-packets traces: coherent batches (primary rays for closest hit, shadow rays for any hit) sixteen consecutive rays a packet, in other batches the runs of sixteen within a narrow cone, the rest ray by ray (both techniques together: what they buy combined)",
+            "bvh8-sbvh's Split BVH traced as bvh8-packets traces: coherent batches (primary rays for closest hit, shadow rays for any hit) sixteen consecutive rays a packet, every other batch ray by ray (both techniques together: what they buy combined)",
             None,
-            |_| WideParams::sbvh().with_packets(),
+            |_| WideParams {
+                coherent_packets: true,
+                ..WideParams::sbvh()
+            },
         ),
         register::<Bvh8Compressed>(
             "bvh8-compressed",
@@ -322,7 +328,7 @@ fn own_structures() -> Vec<StructureEntry> {
         ),
         register::<EmbreeScene>(
             "embree-medium-stream",
-            "embree-medium; closest-hit batches traced through rtcIntersect1M, coherent ones (primary rays) with RTC_INTERSECT_CONTEXT_FLAG_COHERENT (Embree's own packets), the others (random, diffuse, Whitted rays) without it; any hit (shadow rays too) as embree-medium",
+            "embree-medium; coherent closest-hit batches (primary rays) traced through rtcIntersect1M with RTC_INTERSECT_CONTEXT_FLAG_COHERENT (Embree's own packets), every other batch (shadow rays too) as embree-medium",
             None,
             embree(EmbreeParams::medium_stream()),
         ),

@@ -36,8 +36,6 @@
 mod avx2;
 mod collapse;
 #[cfg(target_arch = "x86_64")]
-mod cones;
-#[cfg(target_arch = "x86_64")]
 mod frustum;
 mod kernels;
 mod node;
@@ -67,7 +65,7 @@ use raybench_accel::{
 };
 use raybench_geom::{Aabb, Ray, RayError, Tri4, TriangleMesh, Vec3};
 use std::sync::Arc;
-use walk::{Stack, new_stack};
+use walk::new_stack;
 
 /// The widest node built (and the size of every traversal stack).
 pub const MAX_WIDTH: usize = 8;
@@ -102,18 +100,6 @@ pub type Bvh8 = BvhWide<8>;
 pub type Bvh4 = BvhWide<4>;
 
 impl<const W: usize> BvhWide<W> {
-    /// Closest hits of `rays` into `out`, ray by ray: the batch loop of the kernel chosen at
-    /// build time.
-    fn intersect_rays(&self, rays: &[Ray], out: &mut [Option<Hit>], stack: &mut Stack) {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.avx2 {
-            return avx2::intersect_all(self, k, rays, out, stack);
-        }
-        for (o, ray) in out.iter_mut().zip(rays) {
-            *o = self.trace::<false, _>(ray, stack, &mut NoCount);
-        }
-    }
-
     pub fn nodes(&self) -> &[WideNode<W>] {
         &self.nodes
     }
@@ -183,13 +169,6 @@ impl<const W: usize> Accel for BvhWide<W> {
             return Err(BuildError::Unsupported(format!(
                 "width {} in a {W}-wide BVH",
                 params.width
-            )));
-        }
-        if let Some(cos) = params.cone_packets
-            && !(cos > 0.0 && cos <= 1.0)
-        {
-            return Err(BuildError::Unsupported(format!(
-                "cone_packets {cos}: the cosine of a cone's half angle must lie in (0, 1]"
             )));
         }
         if params.node_format != NodeFormat::Float {
@@ -288,13 +267,12 @@ impl<const W: usize> Accel for BvhWide<W> {
         let mut stack = new_stack();
         let rays = &rays[first..];
         #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.coherent
-            && let Some(cos) = self.params.cone_packets
-        {
-            let single = |r: &[Ray], o: &mut [Option<Hit>]| self.intersect_rays(r, o, &mut stack);
-            return cones::intersect_with_cones(k, self, rays, out, cos, single);
+        if let Some(k) = self.avx2 {
+            return avx2::intersect_all(self, k, rays, out, &mut stack);
         }
-        self.intersect_rays(rays, out, &mut stack);
+        for (o, ray) in out.iter_mut().zip(rays) {
+            *o = self.trace::<false, _>(ray, &mut stack, &mut NoCount);
+        }
     }
 
     fn occluded_prepared(

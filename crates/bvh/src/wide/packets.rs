@@ -53,18 +53,13 @@ use std::arch::x86_64::*;
 /// A subtree still to visit: its reference, the smallest entry distance among the lanes that
 /// entered its box, and those lanes.
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Entry {
+struct Entry {
     r: ChildRef,
     t_entry: f32,
     lanes: u16,
 }
 
-/// A packet walk's stack: scratch space, so a caller tracing many packets allocates it once.
-pub(crate) type PacketStack = [Entry; STACK];
-
-pub(crate) fn new_packet_stack() -> Box<PacketStack> {
-    Box::new([Entry::default(); STACK])
-}
+type PacketStack = [Entry; STACK];
 
 /// Traces a coherent batch (closest hit), one packet per block; `out` gets the first
 /// `out.len()` rays of `blocks`.
@@ -74,8 +69,9 @@ pub(crate) fn intersect_coherent<const W: usize>(
     blocks: &[RayBlock],
     out: &mut [Option<Hit>],
 ) {
+    let mut stack: Box<PacketStack> = Box::new([Entry::default(); STACK]);
     // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-    unsafe { intersect_packets(bvh, blocks, out, &mut new_packet_stack()) }
+    unsafe { intersect_packets(bvh, blocks, out, &mut stack) }
 }
 
 #[target_feature(enable = "avx512f")]
@@ -96,19 +92,6 @@ fn intersect_packets<const W: usize>(
             *o = (prim != NO_PRIM).then(|| Hit::from_tri_hit(prim, h));
         }
     }
-}
-
-/// [`intersect_coherent`] on a stack the caller keeps: for the packets `cones.rs` forms while
-/// tracing, one block at a time.
-pub(crate) fn intersect_blocks<const W: usize>(
-    _k: Avx512Packets,
-    bvh: &BvhWide<W>,
-    blocks: &[RayBlock],
-    out: &mut [Option<Hit>],
-    stack: &mut PacketStack,
-) {
-    // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-    unsafe { intersect_packets(bvh, blocks, out, stack) }
 }
 
 /// The walk of the `active` lanes, whose directions all lie in `octant`. Each subtree is
@@ -207,8 +190,9 @@ pub(crate) fn occluded_coherent<const W: usize>(
     blocks: &[RayBlock],
     out: &mut [bool],
 ) {
+    let mut stack: Box<PacketStack> = Box::new([Entry::default(); STACK]);
     // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-    unsafe { occluded_packets(bvh, blocks, out, &mut new_packet_stack()) }
+    unsafe { occluded_packets(bvh, blocks, out, &mut stack) }
 }
 
 #[target_feature(enable = "avx512f")]

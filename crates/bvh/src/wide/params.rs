@@ -69,12 +69,6 @@ pub struct WideParams {
     /// when the CPU has AVX-512F; every other batch, and every batch without AVX-512, ray by
     /// ray. The registry's `bvh8-packets`.
     pub coherent_packets: bool,
-    /// With `coherent_packets`, batches not prepared as coherent (random, diffuse and Whitted
-    /// rays) are searched for packets too: each run of sixteen consecutive rays whose
-    /// directions share one octant and lie within the cone of this cosine around the first's is
-    /// traced as a packet, the rest ray by ray (`cones.rs`). `None`: every such batch ray by ray.
-    /// Must lie in `(0, 1]`.
-    pub cone_packets: Option<f32>,
     /// The node format; each tree type is built only with its own.
     pub node_format: NodeFormat,
 }
@@ -90,17 +84,6 @@ impl WideParams {
 }
 
 impl WideParams {
-    /// These knobs with the packet walks: coherent batches in packets, and in other batches
-    /// the groups within a cone of cosine 0.995 (about 5.7 degrees; measured: see
-    /// docs/experiments.md, "incoherent batches in bvh8-packets walked as packets").
-    pub fn with_packets(self) -> WideParams {
-        WideParams {
-            coherent_packets: true,
-            cone_packets: Some(0.995),
-            ..self
-        }
-    }
-
     /// The 8-wide defaults over a binary tree built with spatial splits (`bvh8-sbvh`).
     pub fn sbvh() -> WideParams {
         let mut p = WideParams::for_width(8);
@@ -133,7 +116,6 @@ impl Default for WideParams {
             collapse: Collapse::Optimal,
             fill_slots: true,
             coherent_packets: false,
-            cone_packets: None,
             node_format: NodeFormat::Float,
         }
     }
