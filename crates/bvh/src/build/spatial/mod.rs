@@ -72,8 +72,8 @@ pub struct SpatialSplits {
     /// object split's children overlap by at least this share of the node's own surface area
     /// (Embree's spatial-split builder makes the same test, with 0.1). Where the children
     /// barely overlap, a cut through their triangles has little to win, while the search —
-    /// every reference chopped at every slab plane of three axes — costs more than the rest of
-    /// the node's work together.
+    /// every reference that crosses a candidate plane clipped there, on three axes — is still
+    /// the largest part of the node's work (60 % of soup 200k's build in a profile).
     /// 0.3 (from 0 to 1): see docs/experiments.md, "spatial splits searched only where the
     /// object split's children overlap by a share of the node".
     pub overlap_share: f32,
