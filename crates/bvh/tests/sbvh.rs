@@ -133,10 +133,11 @@ fn no_budget_builds_the_binned_tree() {
 }
 
 /// The tree, its references and every ray's answer and counters are the same on one and two
-/// threads (the budget is shared top-down, never first come, first served).
+/// threads (the budget is shared top-down, never first come, first served, and a reference's
+/// cuts are counted along its own line of cuts: city's ground reaches the default limit).
 #[test]
 fn sbvh_is_the_same_with_one_and_two_threads() {
-    for spec in ["hair", "soup:triangles=20000"] {
+    for spec in ["hair", "soup:triangles=20000", "city:triangles=30000"] {
         let mesh = raybench_testkit::generated(spec, 5);
         let build = |threads| {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -228,5 +229,64 @@ fn an_overlap_share_outside_0_to_1_is_refused() {
     }
     for share in [0.0, 1.0] {
         with(share).expect("builds");
+    }
+}
+
+/// No triangle ends in more than `2^max_cuts` references. City's two ground triangles span the
+/// scene and are cut at node after node: without a limit (64) some triangle has more pieces
+/// than a low limit allows, so a knob that changed nothing would fail here; at each limit the
+/// tree still validates and answers every ray as brute force does.
+#[test]
+fn max_cuts_bounds_the_pieces_of_every_triangle() {
+    let mesh = raybench_testkit::generated("city:triangles=20000", 4);
+    let most_pieces = |max_cuts: u32| {
+        let mut p = BvhParams::sbvh();
+        p.spatial_splits.as_mut().unwrap().max_cuts = max_cuts;
+        let bvh = Bvh::build(mesh.clone(), &p).expect("builds");
+        bvh.validate(&mesh).expect("validates");
+        let mut pieces = vec![0u32; mesh.len()];
+        for &id in bvh.prim_ids() {
+            pieces[id as usize] += 1;
+        }
+        pieces.into_iter().max().expect("triangles")
+    };
+    assert!(most_pieces(64) > 8, "the ground is cut more than 3 times");
+    for max_cuts in [0, 1, 3] {
+        let most = most_pieces(max_cuts);
+        assert!(most <= 1 << max_cuts, "max_cuts {max_cuts}: {most} pieces");
+    }
+    assert_eq!(most_pieces(3), 8, "the limit is reached, not undershot");
+    let rays = raybench_testkit::random_rays_in(&mesh.bounds().enlarged(0.1), 3000, 4);
+    let case = Case {
+        name: "city, max_cuts 1".into(),
+        seed: 4,
+        mesh: mesh.clone(),
+        rays,
+    };
+    let mut p = WideParams::sbvh();
+    p.binary.spatial_splits.as_mut().unwrap().max_cuts = 1;
+    let counts =
+        check_case::<Bvh8>(&case, &p, &|b, m| b.validate(m)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(counts.mismatch, 0, "{counts:?}");
+}
+
+/// More cuts than a reference's count holds are refused before the build; both ends build.
+#[test]
+fn max_cuts_past_64_is_refused() {
+    use raybench_accel::BuildError;
+    let mesh = raybench_testkit::generated("soup:triangles=2000", 1);
+    let with = |max_cuts: u32| {
+        let mut p = BvhParams::sbvh();
+        p.spatial_splits.as_mut().unwrap().max_cuts = max_cuts;
+        Bvh::build(mesh.clone(), &p)
+    };
+    for max_cuts in [65, u32::MAX] {
+        assert!(
+            matches!(with(max_cuts), Err(BuildError::Unsupported(ref m)) if m.contains("max_cuts")),
+            "{max_cuts}"
+        );
+    }
+    for max_cuts in [0, 64] {
+        with(max_cuts).expect("builds");
     }
 }

@@ -10,7 +10,7 @@
 //!
 //! `cargo run --release -p raybench-harness --example sbvh_tune -- hair 2 5 1e-5,0.5,32 1e-4,0.5,32`
 //! (scene: an .obj path or a generator spec; threads; rounds; then one
-//! `alpha,growth,bins[,intersection_cost[,overlap_share]]` per configuration).
+//! `alpha,growth,bins[,intersection_cost[,overlap_share[,max_cuts]]]` per configuration).
 
 use raybench_accel::Accel;
 use raybench_bvh::{Bvh8, SpatialSplits, WideParams};
@@ -36,6 +36,7 @@ fn main() {
                 spatial_bins: v[2] as u32,
                 intersection_cost: v.get(3).copied().unwrap_or(d.intersection_cost),
                 overlap_share: v.get(4).copied().unwrap_or(d.overlap_share),
+                max_cuts: v.get(5).map_or(d.max_cuts, |&c| c as u32),
             }
         })
         .collect();
@@ -54,10 +55,15 @@ fn main() {
     for c in &configs {
         let mut p = WideParams::sbvh();
         p.binary.spatial_splits = Some(*c);
-        // The five knobs in the order the configuration takes them.
+        // The six knobs in the order the configuration takes them.
         let name = format!(
-            "sbvh {},{},{},{},{}",
-            c.alpha, c.max_reference_growth, c.spatial_bins, c.intersection_cost, c.overlap_share
+            "sbvh {},{},{},{},{},{}",
+            c.alpha,
+            c.max_reference_growth,
+            c.spatial_bins,
+            c.intersection_cost,
+            c.overlap_share,
+            c.max_cuts
         );
         params.push((name, p));
     }

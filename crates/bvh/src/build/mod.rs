@@ -32,7 +32,7 @@ pub use split::MAX_BINS;
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::{Builder, BvhParams};
 pub(crate) use prim::{Box3, PrimRef};
-use prim::{MAX_PRIMS, Ranged};
+use prim::{MAX_CUTS, MAX_PRIMS, Ranged};
 use raybench_accel::{BuildError, BuildStats, SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use raybench_geom::{Aabb, TriangleMesh};
 use rayon::prelude::*;
@@ -96,6 +96,12 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
             return Err(BuildError::Unsupported(format!(
                 "overlap_share from 0 to 1 (got {})",
                 s.overlap_share
+            )));
+        }
+        if s.max_cuts > MAX_CUTS {
+            return Err(BuildError::Unsupported(format!(
+                "max_cuts from 0 to {MAX_CUTS} (got {})",
+                s.max_cuts
             )));
         }
         return Ok(spatial::build(mesh, params, s));

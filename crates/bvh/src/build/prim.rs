@@ -1,5 +1,6 @@
 //! The builder's working set: one 32-byte record per triangle (its box, with the triangle's id
-//! riding in the spare lane), and SIMD boxes for bins and ranges.
+//! and, for a piece of a triangle, how often it was cut riding in the spare lanes), and SIMD
+//! boxes for bins and ranges.
 
 use glam::{Vec3A, Vec4};
 use raybench_geom::{Aabb, Vec3};
@@ -19,10 +20,23 @@ pub(crate) struct PrimRef {
 
 impl PrimRef {
     pub(crate) fn new(bounds: &Aabb, id: u32) -> PrimRef {
+        PrimRef::piece(bounds, id, 0)
+    }
+
+    /// A reference to the part of triangle `id` inside `bounds`, made by `cuts` cuts.
+    pub(crate) fn piece(bounds: &Aabb, id: u32, cuts: u32) -> PrimRef {
+        debug_assert!(cuts <= MAX_CUTS);
         PrimRef {
             lo: bounds.min.extend(f32::from_bits(id | ID_TAG)),
-            hi: bounds.max.extend(0.0),
+            hi: bounds.max.extend(cuts as f32),
         }
+    }
+
+    /// How many cuts made this reference out of its triangle: its piece is one of at most
+    /// `2^cuts` the triangle has.
+    #[inline(always)]
+    pub(crate) fn cuts(&self) -> u32 {
+        self.hi.w as u32
     }
 
     #[inline(always)]
@@ -53,6 +67,10 @@ impl PrimRef {
 }
 
 const ID_TAG: u32 = 1 << 30;
+
+/// The most cuts a reference's count can hold exactly (a whole float up to 2^24 would do; a
+/// lineage of cuts is never deeper than the tree).
+pub(crate) const MAX_CUTS: u32 = 64;
 
 /// The largest mesh the id encoding can hold.
 pub(crate) const MAX_PRIMS: usize = 1 << 30;

@@ -4,6 +4,10 @@
 //! Stich, Friedrich and Dietrich 2009, section 4.3): a large box that barely crosses the plane
 //! costs less as one reference than as two. Unsplitting is decided reference by reference in
 //! array order, against the children as the binning estimated them, so it is deterministic.
+//! A reference already cut `max_cuts` times from its triangle is not cut again but kept whole
+//! on the cheaper side: a triangle spanning the scene (a city's ground) would otherwise be cut
+//! at nearly every node down to the leaves, a thousand pieces of one triangle filling the
+//! budget and the leaves with references a ray tests one after another.
 
 use super::bins::SpatialSplit;
 use super::chop::{corners, is_empty, split_at};
@@ -18,6 +22,7 @@ pub(crate) fn divide(
     refs: &[PrimRef],
     mesh: &TriangleMesh,
     s: &SpatialSplit,
+    max_cuts: u32,
     left: &mut Vec<PrimRef>,
     right: &mut Vec<PrimRef>,
 ) -> Option<usize> {
@@ -55,17 +60,19 @@ pub(crate) fn divide(
         let cut = al * nl + ar * nr;
         let keep_left = whole_left.half_area() * nl + ar * (nr - 1.0);
         let keep_right = al * (nl - 1.0) + whole_right.half_area() * nr;
-        if keep_left < cut && keep_left <= keep_right {
+        let capped = r.cuts() >= max_cuts;
+        if (capped || keep_left < cut) && keep_left <= keep_right {
             left.push(*r);
             left_box = whole_left;
             nr -= 1.0;
-        } else if keep_right < cut {
+        } else if capped || keep_right < cut {
             right.push(*r);
             right_box = whole_right;
             nl -= 1.0;
         } else {
-            left.push(PrimRef::new(&lp.to_aabb(), r.id()));
-            right.push(PrimRef::new(&rp.to_aabb(), r.id()));
+            let cuts = r.cuts() + 1;
+            left.push(PrimRef::piece(&lp.to_aabb(), r.id(), cuts));
+            right.push(PrimRef::piece(&rp.to_aabb(), r.id(), cuts));
             duplicates += 1;
         }
     }
@@ -118,7 +125,7 @@ mod tests {
         let s = best_spatial_split(&refs, &mesh, &bounds, &p, limits(64, None), &mut bins)
             .expect("a plane");
         let (mut left, mut right) = (Vec::new(), Vec::new());
-        let duplicates = divide(&refs, &mesh, &s, &mut left, &mut right).expect("both sides");
+        let duplicates = divide(&refs, &mesh, &s, 64, &mut left, &mut right).expect("both sides");
         assert_eq!(left.len() + right.len(), refs.len() + duplicates);
         assert!(duplicates > 0 && duplicates <= 64);
         // Each piece lies within its triangle's box and on its side of the plane.

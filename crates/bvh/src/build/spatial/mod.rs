@@ -77,6 +77,12 @@ pub struct SpatialSplits {
     /// 0.3 (from 0 to 1): see docs/experiments.md, "spatial splits searched only where the
     /// object split's children overlap by a share of the node".
     pub overlap_share: f32,
+    /// A reference is cut at most this many times from its triangle (from 0 to 64),
+    /// so a triangle ends in at most `2^max_cuts` pieces; a reference at the limit that
+    /// crosses a split's plane stays whole on the cheaper side. Counted along each piece's own
+    /// line of cuts, not per triangle over the build, so the tree does not depend on the order
+    /// the tasks run in.
+    pub max_cuts: u32,
 }
 
 impl Default for SpatialSplits {
@@ -87,6 +93,7 @@ impl Default for SpatialSplits {
             spatial_bins: 16,
             intersection_cost: 0.3,
             overlap_share: 0.3,
+            max_cuts: 6,
         }
     }
 }
@@ -288,7 +295,14 @@ impl Ctx<'_> {
             && let Some(s) = self.search(slot.live(), &r.bounds, budget, object_cost, w)
             && object_cost.is_none_or(|c| s.cost < c)
             && worth_splitting(q, n, s.cost)
-            && let Some(duplicates) = divide(slot.live(), self.mesh, &s, &mut w.left, &mut w.right)
+            && let Some(duplicates) = divide(
+                slot.live(),
+                self.mesh,
+                &s,
+                self.s.max_cuts,
+                &mut w.left,
+                &mut w.right,
+            )
         {
             let placed = Placed::new([w.left.len(), w.right.len()], budget, duplicates, true);
             // Only a cut the binning misjudged can add more references than the budget
