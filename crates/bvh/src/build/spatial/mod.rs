@@ -81,7 +81,11 @@ pub struct SpatialSplits {
     /// so a triangle ends in at most `2^max_cuts` pieces; a reference at the limit that
     /// crosses a split's plane stays whole on the cheaper side. Counted along each piece's own
     /// line of cuts, not per triangle over the build, so the tree does not depend on the order
-    /// the tasks run in.
+    /// the tasks run in. 6 (at most 64 pieces): city's two ground triangles were cut over a
+    /// thousand times each without it; at 6 its SAH cost falls from 29.55 to 27.66 (the binned
+    /// tree 28.26) and its build from 105 to 62 ms, while grass, Sponza, hair, conference and
+    /// seven of nine generated scenes at other sizes keep the same trees; 4 changes those
+    /// (docs/experiments.md, "at most `max_cuts` cuts").
     pub max_cuts: u32,
 }
 
