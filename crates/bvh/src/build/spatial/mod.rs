@@ -83,9 +83,9 @@ pub struct SpatialSplits {
     /// line of cuts, not per triangle over the build, so the tree does not depend on the order
     /// the tasks run in. 6 (at most 64 pieces): city's two ground triangles were cut over a
     /// thousand times each without it; at 6 its SAH cost falls from 29.55 to 27.66 (the binned
-    /// tree 28.26) and its build from 105 to 62 ms, while grass, Sponza, hair, conference and
-    /// seven of nine generated scenes at other sizes keep the same trees; 4 changes those
-    /// (docs/experiments.md, "at most `max_cuts` cuts").
+    /// tree 28.26) and its build from 105 to 62 ms, while Sponza, hair, conference and seven of
+    /// nine generated scenes at other sizes keep the same trees and grass all but one split; 4
+    /// changes those (docs/experiments.md, "at most `max_cuts` cuts").
     pub max_cuts: u32,
 }
 
