@@ -485,3 +485,64 @@ fn replay_prints_every_answer_and_rejects_bad_rays() {
         "'0xZZ'",
     );
 }
+
+/// A suite may name its seed (the holdout suite does, so that it differs from the seed every
+/// tuning run used); `--seed` still wins, and without either the seed is 1. The seed reaches
+/// the report and the generated scenes, for `run` and `verify` alike.
+#[test]
+fn a_suite_names_its_seed_and_the_flag_overrides_it() {
+    let d = scratch("suite-seed");
+    let suites = d.join("suites");
+    std::fs::create_dir_all(&suites).unwrap();
+    let manifest = |seed: &str| {
+        format!(
+            r#"{{"name": "seeded", "description": "a seeded suite",
+                "scenes": ["soup:triangles=200"], "structures": ["bvh-binned"],
+                "workloads": ["primary"], "rays": 200{seed}}}"#
+        )
+    };
+    // `run` writes report.json (seed under `run`, and per generated scene), `verify`
+    // verify.json (seed under `settings`).
+    let seed_in = |out: &std::path::Path, file: &str, pointer: &str| {
+        let text = std::fs::read_to_string(out.join(file)).unwrap();
+        let report: serde_json::Value = serde_json::from_str(&text).unwrap();
+        report.pointer(pointer).and_then(serde_json::Value::as_u64)
+    };
+    for (suite_seed, flag, expected) in
+        [(Some(5), None, 5), (Some(5), Some("9"), 9), (None, None, 1)]
+    {
+        let field = suite_seed.map_or(String::new(), |s| format!(r#", "seed": {s}"#));
+        std::fs::write(suites.join("seeded.json"), manifest(&field)).unwrap();
+        for command in ["run", "verify"] {
+            let out = d.join(format!("{command}-{expected}"));
+            let mut args = vec![command, "--suite", "seeded"];
+            if command == "run" {
+                args.extend(["--no-images", "--build-runs", "1", "--trace-runs", "1"]);
+            }
+            if let Some(flag) = flag {
+                args.extend(["--seed", flag]);
+            }
+            let status = raybench()
+                .env("RAYBENCH_SUITES", &suites)
+                .args(&args)
+                .arg("--out")
+                .arg(&out)
+                .output()
+                .unwrap();
+            assert!(
+                status.status.success(),
+                "{args:?}: {}",
+                String::from_utf8_lossy(&status.stderr)
+            );
+            if command == "run" {
+                assert_eq!(seed_in(&out, "report.json", "/run/seed"), Some(expected));
+                let scene = "/scenes/0/source/procedural/seed";
+                assert_eq!(seed_in(&out, "report.json", scene), Some(expected));
+            } else {
+                let seed = seed_in(&out, "verify.json", "/settings/seed");
+                assert_eq!(seed, Some(expected), "{args:?}");
+            }
+        }
+    }
+    std::fs::remove_dir_all(d).unwrap();
+}

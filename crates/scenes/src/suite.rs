@@ -22,6 +22,11 @@ pub struct Suite {
     /// hundred times a ray (bvh on the bunny: ~0.5 Mqueries/s near the surface).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub points: Option<usize>,
+    /// The seed of the scenes and rays when the command gives none; absent means the
+    /// command's default (1). A suite of scenes held out from tuning names its own, so that
+    /// it differs from the seed every tuning run used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
 }
 
 /// A scene of a suite: a [`generate`](fn@crate::generate) spec, or an OBJ file.

@@ -24,6 +24,8 @@ fn every_suite_parses_and_names_only_valid_specs() {
         "sweep-stadium",
         "sweep-grass",
         "adversarial",
+        "race",
+        "holdout",
     ] {
         assert!(names.contains(&expected), "{expected} missing: {names:?}");
     }
@@ -43,6 +45,47 @@ fn every_suite_parses_and_names_only_valid_specs() {
             if let SuiteScene::Generated(spec) = scene {
                 raybench_scenes::check_spec(spec).unwrap_or_else(|e| panic!("{}: {e}", suite.name));
             }
+        }
+    }
+}
+
+/// The holdout suite checks tuning where nothing was tuned: none of its scenes is one of the
+/// suites measured while tuning, it covers every generator family of the race suite, and its
+/// seed is not the default one every tuning run used.
+#[test]
+fn the_holdout_suite_shares_no_scene_or_seed_with_the_tuning_suites() {
+    let (_, holdout) = repository_suite("holdout.json");
+    assert!(holdout.seed.is_some_and(|s| s != 1), "{:?}", holdout.seed);
+    let generated = |suite: &Suite| -> Vec<String> {
+        suite
+            .scenes
+            .iter()
+            .filter_map(|s| match s {
+                SuiteScene::Generated(spec) => Some(spec.clone()),
+                SuiteScene::File { .. } => None,
+            })
+            .collect()
+    };
+    let family = |spec: &str| spec.split(':').next().unwrap().to_owned();
+    let held = generated(&holdout);
+    assert!(
+        held.iter().all(|s| s.contains(':')),
+        "every scene sized: {held:?}"
+    );
+    for tuning in ["default.json", "race.json", "ci.json"] {
+        let (_, suite) = repository_suite(tuning);
+        assert!(suite.seed.is_none(), "{tuning} runs at the default seed");
+        let specs = generated(&suite);
+        for spec in &held {
+            assert!(!specs.contains(spec), "{spec} is also in {tuning}");
+        }
+        if tuning == "race.json" {
+            for spec in &specs {
+                let f = family(spec);
+                assert!(held.iter().any(|h| family(h) == f), "no {f} scene held out");
+            }
+            assert_eq!(holdout.structures, suite.structures, "the race's entries");
+            assert_eq!(holdout.workloads, suite.workloads);
         }
     }
 }

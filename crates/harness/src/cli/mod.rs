@@ -32,6 +32,9 @@ use std::process::ExitCode;
 /// tens of Mrays/s), so 10,000 points take about as long as a 100,000-ray workload.
 pub const DEFAULT_POINTS: usize = 10_000;
 
+/// The seed of scenes and rays when neither `--seed` nor the suite gives one.
+pub const DEFAULT_SEED: u64 = 1;
+
 /// A count that must be at least 1: `--rays 0` or `--threads abc` is refused by clap as
 /// `invalid value '0' for '--rays <RAYS>': must be a whole number of at least 1`.
 pub(crate) fn at_least_one(text: &str) -> Result<usize, String> {
@@ -74,8 +77,9 @@ pub struct Selection {
     /// Worker threads for builds and traces (Embree gets threads=N); at most 8 per core.
     #[arg(long, default_value_t = 1, value_parser = bounds::threads)]
     pub threads: usize,
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
+    /// Seed of the generated scenes and the rays (default: the suite's, else 1).
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Enable flush-to-zero and denormals-are-zero on every worker (Embree and native alike).
     #[arg(long)]
     pub ftz_daz: bool,
@@ -89,6 +93,7 @@ pub struct Resolved {
     pub workloads: Vec<Workload>,
     pub rays: usize,
     pub points: usize,
+    pub seed: u64,
 }
 
 /// What applies when neither the flags nor the suite say.
@@ -151,6 +156,10 @@ impl Selection {
             .points
             .or(suite.as_ref().and_then(|s| s.points))
             .unwrap_or(defaults.points);
+        let seed = self
+            .seed
+            .or(suite.as_ref().and_then(|s| s.seed))
+            .unwrap_or(DEFAULT_SEED);
         let source = |flag: &str| match (&self.suite, suite.is_some()) {
             (Some(name), true) => format!("{flag} (with suite '{name}')"),
             _ => flag.to_string(),
@@ -171,6 +180,7 @@ impl Selection {
             workloads,
             rays,
             points,
+            seed,
         })
     }
 }

@@ -92,7 +92,7 @@ pub fn run(registry: &Registry, args: RunArgs) -> Result<ExitCode> {
         points: r.points,
         threads: sel.threads,
         reference: args.reference,
-        seed: sel.seed,
+        seed: r.seed,
         build_runs: args.build_runs,
         trace_runs: args.trace_runs,
         time_budget: args.time_budget.map(std::time::Duration::from_secs_f64),

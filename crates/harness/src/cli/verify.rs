@@ -65,7 +65,7 @@ pub fn run(registry: &Registry, args: VerifyArgs) -> Result<ExitCode> {
         rays: r.rays,
         points: r.points,
         threads: args.selection.threads,
-        seed: args.selection.seed,
+        seed: r.seed,
         ftz_daz: args.selection.ftz_daz,
         progress: std::io::stdout().is_terminal(),
         brute_force_budget: args.brute_force_budget,
