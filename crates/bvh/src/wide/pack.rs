@@ -3,7 +3,13 @@
 use super::node::WideNode;
 use crate::build::PrimRef;
 use crate::node::ChildRef;
+use crate::simd::prefetch;
 use raybench_geom::{MollerTriangle, Tri4, TriangleMesh};
+
+/// `Tri4`s ahead of the one being filled whose vertices are prefetched, their indices twice as
+/// far ahead: up to 8 and 16 triangles, as the spatial search prefetches references (not tuned
+/// here).
+const AHEAD: usize = 2;
 
 /// One `Tri4`'s triangles: the builder's records `refs[start..start + len]`, `len` 1 to 4.
 #[derive(Clone, Copy)]
@@ -16,18 +22,36 @@ pub(super) struct Tri4Source {
 /// triangle's vertices from the mesh is the part of the collapse that touches memory at
 /// random, and `Tri4`s are independent. The length is known, so the indexed `collect` writes
 /// each `Tri4` straight into its place, with no per-task lists and final copy (measured: see
-/// docs/experiments.md, "`Tri4`s built by an indexed parallel `collect`"). The result does not
-/// depend on the thread count.
+/// docs/experiments.md, "`Tri4`s built by an indexed parallel `collect`"). Each task fills
+/// consecutive `Tri4`s, so the indices and vertices of the triangles a few `Tri4`s on are
+/// prefetched while one is filled (measured: see docs/experiments.md, "the `Tri4` fill
+/// prefetching"). The result does not depend on the thread count.
 pub(super) fn fill_tri4s(
     mesh: &TriangleMesh,
     refs: &[PrimRef],
     sources: &[Tri4Source],
 ) -> Vec<Tri4> {
     use rayon::prelude::*;
-    sources
-        .par_iter()
+    let (indices, positions) = (mesh.indices(), mesh.positions());
+    // The records of the `Tri4` `by` after the `k`-th (none past the last).
+    let ahead = |k: usize, by: usize| {
+        sources.get(k + by).map_or(&[][..], |a| {
+            &refs[a.start as usize..(a.start + a.len) as usize]
+        })
+    };
+    (0..sources.len())
+        .into_par_iter()
         .with_min_len(1024)
-        .map(|s| {
+        .map(|k| {
+            let s = sources[k];
+            for p in ahead(k, 2 * AHEAD) {
+                prefetch(indices.as_ptr().wrapping_add(p.id() as usize));
+            }
+            for p in ahead(k, AHEAD) {
+                for v in indices[p.id() as usize] {
+                    prefetch(positions.as_ptr().wrapping_add(v as usize));
+                }
+            }
             let mut tri4 = Tri4::default();
             for (lane, p) in refs[s.start as usize..(s.start + s.len) as usize]
                 .iter()
