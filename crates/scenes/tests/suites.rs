@@ -49,9 +49,9 @@ fn every_suite_parses_and_names_only_valid_specs() {
     }
 }
 
-/// The holdout suite checks tuning where nothing was tuned: none of its scenes is one of the
-/// suites measured while tuning, it covers every generator family of the race suite, and its
-/// seed is not the default one every tuning run used.
+/// The holdout suite checks gains where no constant was tuned: none of its scenes is one of
+/// the suites that tuning runs measure, it covers every generator family of the race suite with
+/// the race's entries, and its seed is not the default one every tuning run used.
 #[test]
 fn the_holdout_suite_shares_no_scene_or_seed_with_the_tuning_suites() {
     let (_, holdout) = repository_suite("holdout.json");
