@@ -18,6 +18,13 @@ pub(super) struct Tri4Source {
     len: u32,
 }
 
+impl Tri4Source {
+    /// Its triangles' records in `refs`.
+    fn records(self, refs: &[PrimRef]) -> &[PrimRef] {
+        &refs[self.start as usize..(self.start + self.len) as usize]
+    }
+}
+
 /// The `Tri4`s in tree order (see [`number_tri4s`]), built on rayon: gathering each
 /// triangle's vertices from the mesh is the part of the collapse that touches memory at
 /// random, and `Tri4`s are independent. The length is known, so the indexed `collect` writes
@@ -34,16 +41,11 @@ pub(super) fn fill_tri4s(
     use rayon::prelude::*;
     let (indices, positions) = (mesh.indices(), mesh.positions());
     // The records of the `Tri4` `by` after the `k`-th (none past the last).
-    let ahead = |k: usize, by: usize| {
-        sources.get(k + by).map_or(&[][..], |a| {
-            &refs[a.start as usize..(a.start + a.len) as usize]
-        })
-    };
+    let ahead = |k: usize, by: usize| sources.get(k + by).map_or(&[][..], |a| a.records(refs));
     (0..sources.len())
         .into_par_iter()
         .with_min_len(1024)
         .map(|k| {
-            let s = sources[k];
             for p in ahead(k, 2 * AHEAD) {
                 prefetch(indices.as_ptr().wrapping_add(p.id() as usize));
             }
@@ -53,10 +55,7 @@ pub(super) fn fill_tri4s(
                 }
             }
             let mut tri4 = Tri4::default();
-            for (lane, p) in refs[s.start as usize..(s.start + s.len) as usize]
-                .iter()
-                .enumerate()
-            {
+            for (lane, p) in sources[k].records(refs).iter().enumerate() {
                 let i = p.id();
                 tri4.set_lane(lane, i, &MollerTriangle::new(&mesh.triangle(i as usize)));
             }
