@@ -3,7 +3,9 @@
 //! an order rotated by r), through the pass `raybench run` times. Prints, per structure and
 //! workload, the median over rounds of (2-thread rate / 1-thread rate): separate runs at
 //! `--threads 1` and `--threads 2` moved by ±15 % between them on this shared machine, pairs of
-//! passes a moment apart do not. Used for the scaling figures in docs/experiments.md
+//! passes a moment apart do not. A third pass per round, on one thread in the calls of
+//! [`CHUNK`] rays a multi-threaded pass makes, gives the cost of those calls alone (its rate
+//! over the one-call pass's: below 1 when a structure pays something per call). Used for the scaling figures in docs/experiments.md
 //! ("rayon tasks of at most four chunks").
 //!
 //! `cargo run --release -p raybench-harness --example trace_scaling -- SCENE[;SCENE...]
@@ -11,7 +13,7 @@
 
 use raybench_accel::Accel;
 use raybench_harness::Registry;
-use raybench_harness::pipeline::measure::{Answers, trace_pass};
+use raybench_harness::pipeline::measure::{Answers, CHUNK, trace_pass};
 use raybench_harness::registry::BuildContext;
 use raybench_scenes::Workload;
 use std::time::Duration;
@@ -24,6 +26,29 @@ fn pool(threads: usize) -> rayon::ThreadPool {
         .num_threads(threads)
         .build()
         .expect("a thread pool")
+}
+
+/// One pass on this thread in the calls a multi-threaded pass makes, one per [`CHUNK`] rays.
+fn chunked_pass(
+    a: &dyn Accel,
+    rays: &[raybench_geom::Ray],
+    p: &raybench_accel::PreparedRays,
+    out: &mut Answers,
+) -> Duration {
+    let start = std::time::Instant::now();
+    match out {
+        Answers::Closest(h) => {
+            for (j, c) in h.chunks_mut(CHUNK).enumerate() {
+                a.intersect_prepared(rays, p, j * CHUNK, c);
+            }
+        }
+        Answers::Any(o) => {
+            for (j, c) in o.chunks_mut(CHUNK).enumerate() {
+                a.occluded_prepared(rays, p, j * CHUNK, c);
+            }
+        }
+    }
+    start.elapsed()
 }
 
 fn main() {
@@ -41,7 +66,9 @@ fn main() {
     // One pool for both: the 1-thread pass is the plain loop on one of its workers. With a
     // second pool, its idle workers spun on the cores the other pool's pass needed.
     let two = pool(2);
-    println!("scene | structure | workload | 1-thread Mrays/s | 2 threads / 1 thread");
+    println!(
+        "scene | structure | workload | 1-thread Mrays/s | 2 threads / 1 thread | 1 thread in calls of {CHUNK} / in one call"
+    );
     for spec in args[0].split(';') {
         let scene = raybench_scenes::resolve(spec, 1).expect("scene");
         let mesh = scene.mesh.clone();
@@ -86,6 +113,7 @@ fn main() {
             let mut out = Answers::new(any_hit, rays.len());
             let mut rate1 = vec![Vec::new(); accels.len()];
             let mut ratio = vec![Vec::new(); accels.len()];
+            let mut chunked = vec![Vec::new(); accels.len()];
             let rate = |d: Duration| rays.len() as f64 / d.as_secs_f64() / 1e6;
             // One untimed pass each, both ways, so caches and workers are warm.
             for (a, p) in accels.iter().zip(&prepared) {
@@ -110,17 +138,20 @@ fn main() {
                             r2,
                         )
                     };
+                    let rc = rate(two.install(|| chunked_pass(a, rays, p, &mut out)));
                     rate1[i].push(r1);
                     ratio[i].push(r2 / r1);
+                    chunked[i].push(rc / r1);
                 }
             }
             for (i, e) in entries.iter().enumerate() {
                 println!(
-                    "{spec} | {} | {} | {:.2} | {:.2}",
+                    "{spec} | {} | {} | {:.2} | {:.2} | {:.2}",
                     e.name,
                     workload.name(),
                     median(rate1[i].clone()),
-                    median(ratio[i].clone())
+                    median(ratio[i].clone()),
+                    median(chunked[i].clone())
                 );
             }
         }

@@ -31,6 +31,7 @@ use raybench_geom::packet::{self, Avx512Packets, Best, PACKET, Packet, RayBlock}
 use raybench_geom::tri4::LANES;
 use raybench_geom::{NO_PRIM, Ray};
 use std::arch::x86_64::*;
+use std::cell::RefCell;
 
 /// A subtree still to visit: the lanes that need it and their intervals.
 #[derive(Clone, Copy, Debug)]
@@ -54,9 +55,10 @@ pub(crate) fn intersect_coherent(
     blocks: &[RayBlock],
     out: &mut [Option<Hit>],
 ) {
-    let mut stack = new_stack();
-    // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-    unsafe { intersect_packets(kd, rays, blocks, out, &mut stack) }
+    PACKET_STACK.with(|s| {
+        // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
+        unsafe { intersect_packets(kd, rays, blocks, out, &mut s.borrow_mut()) }
+    })
 }
 
 #[target_feature(enable = "avx512f")]
@@ -88,9 +90,10 @@ pub(crate) fn occluded_coherent(
     blocks: &[RayBlock],
     out: &mut [bool],
 ) {
-    let mut stack = new_stack();
-    // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-    unsafe { occluded_packets(kd, rays, blocks, out, &mut stack) }
+    PACKET_STACK.with(|s| {
+        // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
+        unsafe { occluded_packets(kd, rays, blocks, out, &mut s.borrow_mut()) }
+    })
 }
 
 #[target_feature(enable = "avx512f")]
@@ -143,6 +146,13 @@ fn walk_packet<const ANY_HIT: bool>(
         }
     });
     done
+}
+
+thread_local! {
+    /// The packet walks' stack, allocated once per thread: a batch traced on several threads
+    /// arrives in calls of a few hundred rays, and allocating and clearing the stack's 9 KB
+    /// per call cost a measurable part of a fast call.
+    static PACKET_STACK: RefCell<Box<PacketStack>> = RefCell::new(new_stack());
 }
 
 fn new_stack() -> Box<PacketStack> {

@@ -65,7 +65,7 @@ use raybench_accel::{
 };
 use raybench_geom::{Aabb, Ray, RayError, Tri4, TriangleMesh, Vec3};
 use std::sync::Arc;
-use walk::new_stack;
+use walk::with_stack;
 
 /// The widest node built (and the size of every traversal stack).
 pub const MAX_WIDTH: usize = 8;
@@ -264,15 +264,16 @@ impl<const W: usize> Accel for BvhWide<W> {
         {
             return packets::intersect_coherent(k, self, packets, out);
         }
-        let mut stack = new_stack();
         let rays = &rays[first..];
-        #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.avx2 {
-            return avx2::intersect_all(self, k, rays, out, &mut stack);
-        }
-        for (o, ray) in out.iter_mut().zip(rays) {
-            *o = self.trace::<false, _>(ray, &mut stack, &mut NoCount);
-        }
+        with_stack(|stack| {
+            #[cfg(target_arch = "x86_64")]
+            if let Some(k) = self.avx2 {
+                return avx2::intersect_all(self, k, rays, out, stack);
+            }
+            for (o, ray) in out.iter_mut().zip(rays) {
+                *o = self.trace::<false, _>(ray, stack, &mut NoCount);
+            }
+        })
     }
 
     fn occluded_prepared(
@@ -289,17 +290,16 @@ impl<const W: usize> Accel for BvhWide<W> {
         {
             return packets::occluded_coherent(k, self, packets, out);
         }
-        let mut stack = new_stack();
         let rays = &rays[first..];
-        #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.avx2 {
-            return avx2::occluded_all(self, k, rays, out, &mut stack);
-        }
-        for (o, ray) in out.iter_mut().zip(rays) {
-            *o = self
-                .trace::<true, _>(ray, &mut stack, &mut NoCount)
-                .is_some();
-        }
+        with_stack(|stack| {
+            #[cfg(target_arch = "x86_64")]
+            if let Some(k) = self.avx2 {
+                return avx2::occluded_all(self, k, rays, out, stack);
+            }
+            for (o, ray) in out.iter_mut().zip(rays) {
+                *o = self.trace::<true, _>(ray, stack, &mut NoCount).is_some();
+            }
+        })
     }
 
     fn build_stats(&self) -> BuildStats {

@@ -49,6 +49,7 @@ use raybench_accel::Hit;
 use raybench_geom::NO_PRIM;
 use raybench_geom::packet::{self, Avx512Packets, Best, PACKET, Packet, RayBlock};
 use std::arch::x86_64::*;
+use std::cell::RefCell;
 
 /// A subtree still to visit: its reference, the smallest entry distance among the lanes that
 /// entered its box, and those lanes.
@@ -61,6 +62,14 @@ struct Entry {
 
 type PacketStack = [Entry; STACK];
 
+thread_local! {
+    /// The packet walks' stack, allocated once per thread: a batch traced on several threads
+    /// arrives in calls of a few hundred rays, and allocating and clearing the stack's 7 KB
+    /// per call cost a measurable part of a fast call.
+    static PACKET_STACK: RefCell<Box<PacketStack>> =
+        RefCell::new(Box::new([Entry::default(); STACK]));
+}
+
 /// Traces a coherent batch (closest hit), one packet per block; `out` gets the first
 /// `out.len()` rays of `blocks`.
 pub(crate) fn intersect_coherent<const W: usize>(
@@ -69,9 +78,10 @@ pub(crate) fn intersect_coherent<const W: usize>(
     blocks: &[RayBlock],
     out: &mut [Option<Hit>],
 ) {
-    let mut stack: Box<PacketStack> = Box::new([Entry::default(); STACK]);
-    // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-    unsafe { intersect_packets(bvh, blocks, out, &mut stack) }
+    PACKET_STACK.with(|s| {
+        // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
+        unsafe { intersect_packets(bvh, blocks, out, &mut s.borrow_mut()) }
+    })
 }
 
 #[target_feature(enable = "avx512f")]
@@ -190,9 +200,10 @@ pub(crate) fn occluded_coherent<const W: usize>(
     blocks: &[RayBlock],
     out: &mut [bool],
 ) {
-    let mut stack: Box<PacketStack> = Box::new([Entry::default(); STACK]);
-    // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-    unsafe { occluded_packets(bvh, blocks, out, &mut stack) }
+    PACKET_STACK.with(|s| {
+        // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
+        unsafe { occluded_packets(bvh, blocks, out, &mut s.borrow_mut()) }
+    })
 }
 
 #[target_feature(enable = "avx512f")]

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 /// Queries per structure call when tracing with several threads: large enough that the call's
 /// setup is noise, small enough to balance 2 cores. Rayon gets at most [`CHUNKS_PER_TASK`] of
 /// them per task.
-const CHUNK: usize = 256;
+pub const CHUNK: usize = 256;
 
 /// Chunks per rayon task (`with_max_len`): about 25–100 µs of tracing, ~1 µs of scheduling.
 /// Left to itself, rayon cuts a batch into a few long runs of chunks up front, and a thread

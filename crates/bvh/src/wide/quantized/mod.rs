@@ -182,29 +182,29 @@ impl<P: Plane> Accel for BvhQuantized<P> {
         first: usize,
         out: &mut [Option<Hit>],
     ) {
-        let mut stack = super::walk::new_stack();
         let rays = &rays[first..];
-        #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.avx2 {
-            return kernels::intersect_all(self, k, rays, out, &mut stack);
-        }
-        for (o, ray) in out.iter_mut().zip(rays) {
-            *o = self.trace::<false, _>(ray, &mut stack, &mut NoCount);
-        }
+        super::walk::with_stack(|stack| {
+            #[cfg(target_arch = "x86_64")]
+            if let Some(k) = self.avx2 {
+                return kernels::intersect_all(self, k, rays, out, stack);
+            }
+            for (o, ray) in out.iter_mut().zip(rays) {
+                *o = self.trace::<false, _>(ray, stack, &mut NoCount);
+            }
+        })
     }
 
     fn occluded_prepared(&self, rays: &[Ray], _: &PreparedRays, first: usize, out: &mut [bool]) {
-        let mut stack = super::walk::new_stack();
         let rays = &rays[first..];
-        #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.avx2 {
-            return kernels::occluded_all(self, k, rays, out, &mut stack);
-        }
-        for (o, ray) in out.iter_mut().zip(rays) {
-            *o = self
-                .trace::<true, _>(ray, &mut stack, &mut NoCount)
-                .is_some();
-        }
+        super::walk::with_stack(|stack| {
+            #[cfg(target_arch = "x86_64")]
+            if let Some(k) = self.avx2 {
+                return kernels::occluded_all(self, k, rays, out, stack);
+            }
+            for (o, ray) in out.iter_mut().zip(rays) {
+                *o = self.trace::<true, _>(ray, stack, &mut NoCount).is_some();
+            }
+        })
     }
 
     fn build_stats(&self) -> BuildStats {

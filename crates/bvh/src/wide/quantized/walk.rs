@@ -7,15 +7,9 @@ use super::node::{Plane, QWIDTH};
 use crate::node::ChildRef;
 use crate::simd::prefetch;
 use crate::wide::kernels::SseNodes;
-use crate::wide::walk::{Stack, first_in_slot_order, nearest_first, new_stack};
+use crate::wide::walk::{Stack, first_in_slot_order, nearest_first, with_stack};
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::{Ray, TriHit};
-use std::cell::RefCell;
-
-thread_local! {
-    /// The single-ray paths' traversal stack, allocated once per thread.
-    static STACK_TLS: RefCell<Box<Stack>> = RefCell::new(new_stack());
-}
 
 impl<P: Plane> BvhQuantized<P> {
     /// The one traversal loop — closest or any hit, counted or not — for a given kernel, with
@@ -143,6 +137,6 @@ impl<P: Plane> BvhQuantized<P> {
         ray: &Ray,
         c: &mut C,
     ) -> Option<Hit> {
-        STACK_TLS.with(|s| self.trace::<ANY_HIT, C>(ray, &mut s.borrow_mut(), c))
+        with_stack(|stack| self.trace::<ANY_HIT, C>(ray, stack, c))
     }
 }
