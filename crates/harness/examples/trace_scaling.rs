@@ -5,8 +5,9 @@
 //! `--threads 1` and `--threads 2` moved by ±15 % between them on this shared machine, pairs of
 //! passes a moment apart do not. A third pass per round, on one thread in the calls of
 //! [`CHUNK`] rays a multi-threaded pass makes, gives the cost of those calls alone (its rate
-//! over the one-call pass's: below 1 when a structure pays something per call). Used for the scaling figures in docs/experiments.md
-//! ("rayon tasks of at most four chunks").
+//! over the one-call pass's: below 1 when a structure pays something per call). Used for the
+//! scaling figures in docs/experiments.md ("rayon tasks of at most four chunks", "traversal
+//! stacks of the batch paths kept per thread").
 //!
 //! `cargo run --release -p raybench-harness --example trace_scaling -- SCENE[;SCENE...]
 //!  STRUCTURE[,STRUCTURE...] [rounds=9] [rays=100000]`
