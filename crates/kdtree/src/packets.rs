@@ -55,9 +55,9 @@ pub(crate) fn intersect_coherent(
     blocks: &[RayBlock],
     out: &mut [Option<Hit>],
 ) {
-    PACKET_STACK.with(|s| {
+    with_packet_stack(|stack| {
         // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-        unsafe { intersect_packets(kd, rays, blocks, out, &mut s.borrow_mut()) }
+        unsafe { intersect_packets(kd, rays, blocks, out, stack) }
     })
 }
 
@@ -90,9 +90,9 @@ pub(crate) fn occluded_coherent(
     blocks: &[RayBlock],
     out: &mut [bool],
 ) {
-    PACKET_STACK.with(|s| {
+    with_packet_stack(|stack| {
         // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-        unsafe { occluded_packets(kd, rays, blocks, out, &mut s.borrow_mut()) }
+        unsafe { occluded_packets(kd, rays, blocks, out, stack) }
     })
 }
 
@@ -153,6 +153,15 @@ thread_local! {
     /// arrives in calls of a few hundred rays, and allocating and clearing the stack's 9 KB
     /// per call cost a measurable part of a fast call.
     static PACKET_STACK: RefCell<Box<PacketStack>> = RefCell::new(new_stack());
+}
+
+/// Runs `f` with this thread's packet stack, or with a stack of its own when a walk on this
+/// thread holds that one already.
+fn with_packet_stack<R>(f: impl FnOnce(&mut PacketStack) -> R) -> R {
+    PACKET_STACK.with(|s| match s.try_borrow_mut() {
+        Ok(mut stack) => f(&mut stack),
+        Err(_) => f(&mut new_stack()),
+    })
 }
 
 fn new_stack() -> Box<PacketStack> {

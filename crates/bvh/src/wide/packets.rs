@@ -70,6 +70,15 @@ thread_local! {
         RefCell::new(Box::new([Entry::default(); STACK]));
 }
 
+/// Runs `f` with this thread's packet stack, or with a stack of its own when a walk on this
+/// thread holds that one already.
+fn with_packet_stack<R>(f: impl FnOnce(&mut PacketStack) -> R) -> R {
+    PACKET_STACK.with(|s| match s.try_borrow_mut() {
+        Ok(mut stack) => f(&mut stack),
+        Err(_) => f(&mut Box::new([Entry::default(); STACK])),
+    })
+}
+
 /// Traces a coherent batch (closest hit), one packet per block; `out` gets the first
 /// `out.len()` rays of `blocks`.
 pub(crate) fn intersect_coherent<const W: usize>(
@@ -78,9 +87,9 @@ pub(crate) fn intersect_coherent<const W: usize>(
     blocks: &[RayBlock],
     out: &mut [Option<Hit>],
 ) {
-    PACKET_STACK.with(|s| {
+    with_packet_stack(|stack| {
         // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-        unsafe { intersect_packets(bvh, blocks, out, &mut s.borrow_mut()) }
+        unsafe { intersect_packets(bvh, blocks, out, stack) }
     })
 }
 
@@ -200,9 +209,9 @@ pub(crate) fn occluded_coherent<const W: usize>(
     blocks: &[RayBlock],
     out: &mut [bool],
 ) {
-    PACKET_STACK.with(|s| {
+    with_packet_stack(|stack| {
         // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-        unsafe { occluded_packets(bvh, blocks, out, &mut s.borrow_mut()) }
+        unsafe { occluded_packets(bvh, blocks, out, stack) }
     })
 }
 

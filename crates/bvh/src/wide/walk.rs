@@ -29,9 +29,13 @@ thread_local! {
     static STACK_TLS: RefCell<Box<Stack>> = RefCell::new(new_stack());
 }
 
-/// Runs `f` with this thread's traversal stack. Not reentrant: `f` must not call it again.
+/// Runs `f` with this thread's traversal stack, or with a stack of its own when a walk on this
+/// thread holds that one already (a tree walked from inside another tree's walk).
 pub(crate) fn with_stack<R>(f: impl FnOnce(&mut Stack) -> R) -> R {
-    STACK_TLS.with(|s| f(&mut s.borrow_mut()))
+    STACK_TLS.with(|s| match s.try_borrow_mut() {
+        Ok(mut stack) => f(&mut stack),
+        Err(_) => f(&mut new_stack()),
+    })
 }
 
 /// Any hit will do, so no sorting (as Embree's occlusion traversal): returns the child in the
@@ -284,6 +288,25 @@ pub(super) fn check_against_insertion(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A walk started inside another on the same thread gets a stack of its own, and the outer
+    /// walk's entries are untouched.
+    #[test]
+    fn a_nested_walk_gets_its_own_stack() {
+        let marker = (ChildRef { index: 7, count: 3 }, 2.5);
+        let (outer, inner) = with_stack(|outer| {
+            outer[0] = marker;
+            let inner = with_stack(|inner| {
+                inner[0] = (ChildRef::default(), -1.0);
+                inner.as_ptr()
+            });
+            (outer[0], inner != outer.as_ptr())
+        });
+        assert_eq!(outer, marker);
+        assert!(inner, "the nested walk had the outer walk's stack");
+        // The thread's stack is free again afterwards.
+        assert_eq!(with_stack(|s| s[0]), marker);
+    }
 
     /// The short paths of [`nearest_first`] (one to three children) order as the insertion.
     #[test]
