@@ -4,6 +4,7 @@
 //! * [`Accel`]: build, closest hit, any hit, the same two with [`Counters`], stats, memory.
 //! * [`Walk`] and [`walk_queries!`]: a structure writes its traversal loops once; the macro
 //!   forwards the six query methods of [`Accel`] to them.
+//! * [`per_thread_stack!`]: a traversal stack kept per thread, lent to each walk.
 //! * [`BruteForce`]: the O(N) oracle every structure is checked against.
 //! * [`classify`]: the validation classes (docs/validation.md, Validation classes), deciding
 //!   whether two answers agree.
@@ -17,6 +18,7 @@ pub mod coherent;
 mod counters;
 mod mailbox;
 mod nearest;
+mod per_thread;
 mod uncounted;
 mod walk;
 

@@ -31,7 +31,6 @@ use raybench_geom::packet::{self, Avx512Packets, Best, PACKET, Packet, RayBlock}
 use raybench_geom::tri4::LANES;
 use raybench_geom::{NO_PRIM, Ray};
 use std::arch::x86_64::*;
-use std::cell::RefCell;
 
 /// A subtree still to visit: the lanes that need it and their intervals.
 #[derive(Clone, Copy, Debug)]
@@ -148,21 +147,10 @@ fn walk_packet<const ANY_HIT: bool>(
     done
 }
 
-thread_local! {
-    /// The packet walks' stack, allocated once per thread: a batch traced on several threads
-    /// arrives in calls of a few hundred rays, and allocating and clearing the stack's 9 KB
-    /// per call cost a measurable part of a fast call.
-    static PACKET_STACK: RefCell<Box<PacketStack>> = RefCell::new(new_stack());
-}
-
-/// Runs `f` with this thread's packet stack, or with a stack of its own when a walk on this
-/// thread holds that one already.
-fn with_packet_stack<R>(f: impl FnOnce(&mut PacketStack) -> R) -> R {
-    PACKET_STACK.with(|s| match s.try_borrow_mut() {
-        Ok(mut stack) => f(&mut stack),
-        Err(_) => f(&mut new_stack()),
-    })
-}
+raybench_accel::per_thread_stack!(
+    /// Runs `f` with this thread's packet stack (a fresh one inside another walk).
+    fn with_packet_stack -> PacketStack = new_stack()
+);
 
 fn new_stack() -> Box<PacketStack> {
     let empty = Entry {

@@ -49,7 +49,6 @@ use raybench_accel::Hit;
 use raybench_geom::NO_PRIM;
 use raybench_geom::packet::{self, Avx512Packets, Best, PACKET, Packet, RayBlock};
 use std::arch::x86_64::*;
-use std::cell::RefCell;
 
 /// A subtree still to visit: its reference, the smallest entry distance among the lanes that
 /// entered its box, and those lanes.
@@ -62,22 +61,10 @@ struct Entry {
 
 type PacketStack = [Entry; STACK];
 
-thread_local! {
-    /// The packet walks' stack, allocated once per thread: a batch traced on several threads
-    /// arrives in calls of a few hundred rays, and allocating and clearing the stack's 7 KB
-    /// per call cost a measurable part of a fast call.
-    static PACKET_STACK: RefCell<Box<PacketStack>> =
-        RefCell::new(Box::new([Entry::default(); STACK]));
-}
-
-/// Runs `f` with this thread's packet stack, or with a stack of its own when a walk on this
-/// thread holds that one already.
-fn with_packet_stack<R>(f: impl FnOnce(&mut PacketStack) -> R) -> R {
-    PACKET_STACK.with(|s| match s.try_borrow_mut() {
-        Ok(mut stack) => f(&mut stack),
-        Err(_) => f(&mut Box::new([Entry::default(); STACK])),
-    })
-}
+raybench_accel::per_thread_stack!(
+    /// Runs `f` with this thread's packet stack (a fresh one inside another walk).
+    fn with_packet_stack -> PacketStack = Box::new([Entry::default(); STACK])
+);
 
 /// Traces a coherent batch (closest hit), one packet per block; `out` gets the first
 /// `out.len()` rays of `blocks`.

@@ -7,7 +7,6 @@ use crate::node::{ChildRef, MAX_DEPTH};
 use crate::simd::prefetch;
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::{Ray, TriHit};
-use std::cell::RefCell;
 
 /// Stack entries a walk can need: a node pushes at most `MAX_WIDTH - 1`, one per level, and
 /// the binary builder caps the depth at [`MAX_DEPTH`] (collapsing only shortens it).
@@ -22,21 +21,10 @@ pub(crate) fn new_stack() -> Box<Stack> {
     Box::new([(ChildRef::default(), 0.0); STACK])
 }
 
-thread_local! {
-    /// The traversal stack of the single-ray paths, allocated once per thread: a batch traced
-    /// on several threads arrives in calls of a few hundred rays, and allocating and clearing
-    /// 5 KB per call cost a measurable part of a fast call.
-    static STACK_TLS: RefCell<Box<Stack>> = RefCell::new(new_stack());
-}
-
-/// Runs `f` with this thread's traversal stack, or with a stack of its own when a walk on this
-/// thread holds that one already (a tree walked from inside another tree's walk).
-pub(crate) fn with_stack<R>(f: impl FnOnce(&mut Stack) -> R) -> R {
-    STACK_TLS.with(|s| match s.try_borrow_mut() {
-        Ok(mut stack) => f(&mut stack),
-        Err(_) => f(&mut new_stack()),
-    })
-}
+raybench_accel::per_thread_stack!(
+    /// Runs `f` with this thread's traversal stack (a fresh one inside another walk).
+    pub(crate) fn with_stack -> Stack = new_stack()
+);
 
 /// Any hit will do, so no sorting (as Embree's occlusion traversal): returns the child in the
 /// lowest slot of `mask` and pushes the others to pop in slot order. Their entry distances are
