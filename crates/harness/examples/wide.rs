@@ -19,7 +19,7 @@
 //! (embree-medium whenever it is kept).
 
 use raybench_accel::{Accel, PreparedRays};
-use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, NodeSimd, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, NodeSimd, PacketFloors, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
 use raybench_scenes::{RayRecipe, SurfaceHit, Workload};
@@ -80,13 +80,33 @@ fn main() {
     add("bvh8", &|| {
         Box::new(Bvh8::build(Arc::clone(&mesh), &WideParams::default()).expect("builds"))
     });
+    // `bvh8-packets` as registered (packets that carry few rays handed to the single-ray
+    // walk), and every packet walked as one.
+    let floors = |floors: PacketFloors| WideParams {
+        coherent_packets: true,
+        packet_floors: floors,
+        ..WideParams::default()
+    };
     add("bvh8-packets", &|| {
-        let packets = WideParams {
-            coherent_packets: true,
-            ..WideParams::default()
-        };
-        Box::new(Bvh8::build(Arc::clone(&mesh), &packets).expect("builds"))
+        Box::new(Bvh8::build(Arc::clone(&mesh), &floors(PacketFloors::MEASURED)).expect("builds"))
     });
+    add("bvh8-packets-all", &|| {
+        Box::new(Bvh8::build(Arc::clone(&mesh), &floors(PacketFloors::OFF)).expect("builds"))
+    });
+    // `RB_FLOORS=8:2,6:3`: `bvh8-packets` again with each `node:tri4` floor pair, labelled
+    // `floors-8:2` and so on.
+    for pair in std::env::var("RB_FLOORS").unwrap_or_default().split(',') {
+        let Some((node, tri4)) = pair.split_once(':') else {
+            continue;
+        };
+        let (Ok(node), Ok(tri4)) = (node.parse(), tri4.parse()) else {
+            continue;
+        };
+        add(&format!("floors-{pair}"), &|| {
+            let f = floors(PacketFloors { node, tri4 });
+            Box::new(Bvh8::build(Arc::clone(&mesh), &f).expect("builds"))
+        });
+    }
     let sse = WideParams {
         node_simd: NodeSimd::Sse,
         ..WideParams::default()
@@ -132,8 +152,9 @@ fn main() {
         let prepared: Vec<PreparedRays> = structures
             .iter()
             .map(|(_, a, _)| {
-                // Primary rays are prepared as the harness prepares them: as a coherent batch.
-                if *name == "primary" {
+                // Primary and shadow rays are prepared as the harness prepares them: as a
+                // coherent batch.
+                if *name == "primary" || *name == "shadow" {
                     a.prepare_coherent_rays(rays).expect("valid rays")
                 } else {
                     a.prepare_rays(rays).expect("valid rays")

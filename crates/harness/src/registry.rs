@@ -8,8 +8,8 @@ pub use program::{RegisterError, Registry};
 
 use raybench_accel::{Accel, BruteForce, BruteForceParams, BuildError};
 use raybench_bvh::{
-    Bvh, Bvh4, Bvh8, Bvh8Compressed, Bvh8Compressed16, BvhParams, NodeFormat, Reinsertion,
-    WideParams,
+    Bvh, Bvh4, Bvh8, Bvh8Compressed, Bvh8Compressed16, BvhParams, NodeFormat, PacketFloors,
+    Reinsertion, WideParams,
 };
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::{TriangleMesh, TriangleTest};
@@ -220,10 +220,11 @@ fn own_structures() -> Vec<StructureEntry> {
         ),
         register::<Bvh8>(
             "bvh8-packets",
-            "the bvh8-binned tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane, every other batch ray by ray as bvh8-binned",
+            "the bvh8-binned tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane, but where a packet's walk shares few nodes and triangles among its rays, the next packets of its 256 rays ray by ray; every other batch ray by ray as bvh8-binned",
             None,
             |_| WideParams {
                 coherent_packets: true,
+                packet_floors: PacketFloors::MEASURED,
                 ..WideParams::for_width(8)
             },
         ),
@@ -233,6 +234,7 @@ fn own_structures() -> Vec<StructureEntry> {
             None,
             |_| WideParams {
                 coherent_packets: true,
+                packet_floors: PacketFloors::MEASURED,
                 ..WideParams::sbvh()
             },
         ),

@@ -50,7 +50,7 @@ mod validate;
 mod walk;
 
 pub use node::WideNode;
-pub use params::{Collapse, NodeFormat, NodeSimd, WideParams};
+pub use params::{Collapse, NodeFormat, NodeSimd, PacketFloors, WideParams};
 pub use quantized::{Bvh8Compressed, Bvh8Compressed16, BvhQuantized, node::Plane, node::QNode};
 
 pub(crate) use node::quad;
@@ -262,7 +262,7 @@ impl<const W: usize> Accel for BvhWide<W> {
             && let Some(packets) =
                 raybench_accel::coherent::packet_blocks(prepared, first, out.len())
         {
-            return packets::intersect_coherent(k, self, packets, out);
+            return packets::intersect_coherent(k, self, packets, &rays[first..], first, out);
         }
         let rays = &rays[first..];
         with_stack(|stack| {
@@ -288,7 +288,7 @@ impl<const W: usize> Accel for BvhWide<W> {
             && let Some(packets) =
                 raybench_accel::coherent::packet_blocks(prepared, first, out.len())
         {
-            return packets::occluded_coherent(k, self, packets, out);
+            return packets::occluded_coherent(k, self, packets, &rays[first..], first, out);
         }
         let rays = &rays[first..];
         with_stack(|stack| {

@@ -18,7 +18,10 @@
 //! single-ray walk on scenes of large triangles (Sponza, the teapots, Sibenik), little or less
 //! where triangles are smaller than the rays' spacing (the stadium from afar, San Francisco).
 //! Handing sparse subtrees or leaves back to the single-ray walk, as Embree's hybrid traversal
-//! does, did not measurably help (docs/experiments.md, "Packets for coherent rays").
+//! does, did not measurably help (docs/experiments.md, "Packets for coherent rays"); handing
+//! whole packets over does, where the rays share little ([`Switch`], the `packet_floors` knob):
+//! a packet walk that carried few rays per node and per `Tri4` sends the next packets of its
+//! window ray by ray.
 //!
 //! Exactness: every lane computes what the single-ray walk computes for its ray, operation for
 //! operation — the slab test with the near planes chosen by the direction's signs
@@ -42,12 +45,14 @@
 //! walk's: occluded exactly when one of the leaves its ray enters holds a triangle hit within
 //! `t_min < t <= t_max`.
 
+use super::avx2;
 use super::frustum::Frustum;
+use super::walk::with_stack;
 use crate::node::ChildRef;
 use crate::wide::{BvhWide, STACK};
 use raybench_accel::Hit;
-use raybench_geom::NO_PRIM;
 use raybench_geom::packet::{self, Avx512Packets, Best, PACKET, Packet, RayBlock};
+use raybench_geom::{NO_PRIM, Ray};
 use std::arch::x86_64::*;
 
 /// A subtree still to visit: its reference, the smallest entry distance among the lanes that
@@ -67,16 +72,18 @@ raybench_accel::per_thread_stack!(
 );
 
 /// Traces a coherent batch (closest hit), one packet per block; `out` gets the first
-/// `out.len()` rays of `blocks`.
+/// `out.len()` rays of `blocks`, which are `rays` (the batch from ray `first` on).
 pub(crate) fn intersect_coherent<const W: usize>(
     _k: Avx512Packets,
     bvh: &BvhWide<W>,
     blocks: &[RayBlock],
+    rays: &[Ray],
+    first: usize,
     out: &mut [Option<Hit>],
 ) {
     with_packet_stack(|stack| {
         // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-        unsafe { intersect_packets(bvh, blocks, out, stack) }
+        unsafe { intersect_packets(bvh, blocks, rays, first, out, stack) }
     })
 }
 
@@ -84,19 +91,103 @@ pub(crate) fn intersect_coherent<const W: usize>(
 fn intersect_packets<const W: usize>(
     bvh: &BvhWide<W>,
     blocks: &[RayBlock],
+    rays: &[Ray],
+    first: usize,
     out: &mut [Option<Hit>],
     stack: &mut PacketStack,
 ) {
-    for (block, out) in blocks.iter().zip(out.chunks_mut(PACKET)) {
+    let mut switch = Switch::new(bvh, first);
+    for ((block, out), rays) in blocks
+        .iter()
+        .zip(out.chunks_mut(PACKET))
+        .zip(rays.chunks(PACKET))
+    {
+        if let Some(single) = switch.ray_by_ray() {
+            with_stack(|s| avx2::intersect_all(bvh, single, rays, out, s));
+            continue;
+        }
         let (packet, mut best) = packet::load(block);
+        let mut usage = Usage::default();
         if !bvh.tri4s().is_empty() {
             packet::octant_groups(&packet, out.len(), |lanes, octant| {
-                walk(bvh, &packet, lanes, octant, &mut best, stack)
+                walk(bvh, &packet, lanes, octant, &mut best, stack, &mut usage)
             });
         }
+        switch.walked(usage);
         for (o, (prim, h)) in out.iter_mut().zip(best.hits()) {
             *o = (prim != NO_PRIM).then(|| Hit::from_tri_hit(prim, h));
         }
+    }
+}
+
+/// Packets a window holds: the harness's chunk of 256 rays on several threads, so a window's
+/// packets are decided alike whether the batch comes in one call or in chunks.
+const WINDOW: usize = 256 / PACKET;
+
+/// What a packet's walk shared among its rays: the nodes and `Tri4`s it visited, and the lanes
+/// active at each visit, summed.
+#[derive(Clone, Copy, Debug, Default)]
+struct Usage {
+    nodes: u32,
+    node_lanes: u32,
+    tri4s: u32,
+    tri4_lanes: u32,
+}
+
+impl Usage {
+    #[inline(always)]
+    fn node(&mut self, lanes: u16) {
+        self.nodes += 1;
+        self.node_lanes += lanes.count_ones();
+    }
+
+    #[inline(always)]
+    fn tri4s(&mut self, count: u32, lanes: u16) {
+        self.tri4s += count;
+        self.tri4_lanes += count * lanes.count_ones();
+    }
+}
+
+/// Whether the next packet of a batch is walked as a packet or ray by ray
+/// ([`PacketFloors`](crate::PacketFloors)): each window's first packet is walked as one, and
+/// each packet so walked decides for the next. A packet's cost is per visit, whatever its
+/// lanes; the rays' own walks cost per lane. So where few lanes share the nodes and few the
+/// `Tri4`s (triangles smaller than the rays' spacing, rays spread by the surfaces they left),
+/// the rays go faster alone.
+struct Switch {
+    floors: crate::PacketFloors,
+    /// The single-ray kernel, when some packets may be traced ray by ray.
+    single: Option<avx2::Avx2Nodes>,
+    /// The next packet's index in the whole batch.
+    next: usize,
+    packets: bool,
+}
+
+impl Switch {
+    fn new<const W: usize>(bvh: &BvhWide<W>, first: usize) -> Switch {
+        let floors = bvh.params.packet_floors;
+        Switch {
+            floors,
+            single: bvh.avx2.filter(|_| floors.node > 0.0 && floors.tri4 > 0.0),
+            next: first / PACKET,
+            packets: true,
+        }
+    }
+
+    /// The single-ray kernel when the next packet is to be traced ray by ray.
+    #[inline(always)]
+    fn ray_by_ray(&mut self) -> Option<avx2::Avx2Nodes> {
+        if self.next.is_multiple_of(WINDOW) {
+            self.packets = true;
+        }
+        self.next += 1;
+        self.single.filter(|_| !self.packets)
+    }
+
+    #[inline(always)]
+    fn walked(&mut self, u: Usage) {
+        self.packets = u.node_lanes as f32 >= self.floors.node * u.nodes as f32
+            || u.tri4_lanes as f32 >= self.floors.tri4 * u.tri4s as f32;
     }
 }
 
@@ -112,6 +203,7 @@ fn walk<const W: usize>(
     octant: u8,
     best: &mut Best,
     stack: &mut PacketStack,
+    usage: &mut Usage,
 ) {
     let frustum = Frustum::new(p, active, octant);
     let near = frustum.near;
@@ -122,11 +214,14 @@ fn walk<const W: usize>(
     'walk: loop {
         if r.is_leaf() {
             let first = r.index as usize;
-            for tri4 in &bvh.tri4s()[first..first + (r.count as usize).div_ceil(4)] {
+            let tri4s = (r.count as usize).div_ceil(4);
+            usage.tri4s(tri4s as u32, lanes);
+            for tri4 in &bvh.tri4s()[first..first + tri4s] {
                 best.test_tri4(tri4, p, lanes);
             }
             farthest = _mm512_mask_reduce_max_ps(active, best.t);
         } else {
+            usage.node(lanes);
             let n = &bvh.nodes()[r.index as usize];
             let base = sp;
             let mut maybe = frustum.maybe_entered(n, farthest);
@@ -189,16 +284,18 @@ fn push_sorted(stack: &mut PacketStack, base: usize, sp: &mut usize, e: Entry) {
 }
 
 /// Traces a coherent batch (any hit), one packet per block; `out` gets the first `out.len()`
-/// rays of `blocks`.
+/// rays of `blocks`, which are `rays` (the batch from ray `first` on).
 pub(crate) fn occluded_coherent<const W: usize>(
     _k: Avx512Packets,
     bvh: &BvhWide<W>,
     blocks: &[RayBlock],
+    rays: &[Ray],
+    first: usize,
     out: &mut [bool],
 ) {
     with_packet_stack(|stack| {
         // SAFETY: an `Avx512Packets` exists only after `detect` saw AVX-512F on this CPU.
-        unsafe { occluded_packets(bvh, blocks, out, stack) }
+        unsafe { occluded_packets(bvh, blocks, rays, first, out, stack) }
     })
 }
 
@@ -206,17 +303,30 @@ pub(crate) fn occluded_coherent<const W: usize>(
 fn occluded_packets<const W: usize>(
     bvh: &BvhWide<W>,
     blocks: &[RayBlock],
+    rays: &[Ray],
+    first: usize,
     out: &mut [bool],
     stack: &mut PacketStack,
 ) {
-    for (block, out) in blocks.iter().zip(out.chunks_mut(PACKET)) {
+    let mut switch = Switch::new(bvh, first);
+    for ((block, out), rays) in blocks
+        .iter()
+        .zip(out.chunks_mut(PACKET))
+        .zip(rays.chunks(PACKET))
+    {
+        if let Some(single) = switch.ray_by_ray() {
+            with_stack(|s| avx2::occluded_all(bvh, single, rays, out, s));
+            continue;
+        }
         let (packet, mut best) = packet::load(block);
         let mut done = 0u16;
+        let mut usage = Usage::default();
         if !bvh.tri4s().is_empty() {
             packet::octant_groups(&packet, out.len(), |lanes, octant| {
-                done |= walk_any(bvh, &packet, lanes, octant, &mut best, stack)
+                done |= walk_any(bvh, &packet, lanes, octant, &mut best, stack, &mut usage)
             });
         }
+        switch.walked(usage);
         for (lane, o) in out.iter_mut().enumerate() {
             *o = done >> lane & 1 == 1;
         }
@@ -234,6 +344,7 @@ fn walk_any<const W: usize>(
     octant: u8,
     best: &mut Best,
     stack: &mut PacketStack,
+    usage: &mut Usage,
 ) -> u16 {
     let t_max = best.t;
     let frustum = Frustum::new(p, active, octant);
@@ -247,7 +358,9 @@ fn walk_any<const W: usize>(
     'walk: loop {
         if r.is_leaf() {
             let first = r.index as usize;
-            for tri4 in &bvh.tri4s()[first..first + (r.count as usize).div_ceil(4)] {
+            let tri4s = (r.count as usize).div_ceil(4);
+            usage.tri4s(tri4s as u32, lanes);
+            for tri4 in &bvh.tri4s()[first..first + tri4s] {
                 best.test_tri4(tri4, p, lanes);
                 let hit = _mm512_mask_cmpneq_epi32_mask(lanes, best.prim, none);
                 if hit != 0 {
@@ -262,6 +375,7 @@ fn walk_any<const W: usize>(
                 }
             }
         } else {
+            usage.node(lanes);
             let n = &bvh.nodes()[r.index as usize];
             let base = sp;
             let mut maybe = frustum.maybe_entered(n, farthest);

@@ -69,8 +69,38 @@ pub struct WideParams {
     /// when the CPU has AVX-512F; every other batch, and every batch without AVX-512, ray by
     /// ray. The registry's `bvh8-packets`.
     pub coherent_packets: bool,
+    /// With `coherent_packets`: when a packet is worth walking as one (else its rays are traced
+    /// ray by ray). Off by default: every packet is walked as one.
+    pub packet_floors: PacketFloors,
     /// The node format; each tree type is built only with its own.
     pub node_format: NodeFormat,
+}
+
+/// When the packet walk hands packets to the single-ray walk. A batch is taken in windows of
+/// sixteen packets (256 rays, the harness's chunk on several threads, so the decisions are the
+/// same on any number of threads). Each window's first packet is walked as a packet; each
+/// packet walked as one decides for the next: it stays a packet while its walk carried, on
+/// average, at least `node` rays per node visited or at least `tri4` rays per `Tri4` tested;
+/// else the window's remaining packets go ray by ray. Zero in either field walks every packet
+/// as one.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PacketFloors {
+    pub node: f32,
+    pub tri4: f32,
+}
+
+impl PacketFloors {
+    /// Every packet walked as one.
+    pub const OFF: PacketFloors = PacketFloors {
+        node: 0.0,
+        tri4: 0.0,
+    };
+    /// The registry's packet entries: measured over generated and real scenes (see
+    /// docs/experiments.md, "packets handed to the single-ray walk by window").
+    pub const MEASURED: PacketFloors = PacketFloors {
+        node: 6.0,
+        tri4: 2.0,
+    };
 }
 
 impl WideParams {
@@ -116,6 +146,7 @@ impl Default for WideParams {
             collapse: Collapse::Optimal,
             fill_slots: true,
             coherent_packets: false,
+            packet_floors: PacketFloors::OFF,
             node_format: NodeFormat::Float,
         }
     }
