@@ -82,8 +82,8 @@ pub struct WideParams {
 /// packet walked as one decides for the next: it stays a packet while its walk carried, on
 /// average, at least `node` rays per node visited or at least `tri4` rays per `Tri4` tested;
 /// else the window's remaining packets go ray by ray. Zero in either field walks every packet
-/// as one, and so does a tree without the AVX2 kernels (`node_simd = sse`), whose single-ray
-/// walk is not the one the packets are measured against.
+/// as one, and so does a tree without the AVX2 kernels (`node_simd = sse`): packets are handed
+/// to the AVX2 single-ray loops.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PacketFloors {
     pub node: f32,
