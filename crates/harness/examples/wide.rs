@@ -9,9 +9,12 @@
 //! optionally one workload). Under `valgrind --tool=callgrind` use few rays and 1 round
 //! (valgrind runs no AVX-512, so there `bvh8` takes the AVX2-only loops).
 //!
-//! Primary rays are prepared as the harness prepares them, as a coherent batch, so
-//! `bvh8-packets` and `embree-medium-stream` trace them in packets (and the other workloads
-//! as `bvh8` and `embree-medium` do).
+//! Primary and shadow rays are prepared as the harness prepares them, as coherent batches, so
+//! `bvh8-packets` and `embree-medium-stream` trace them in packets (and the random rays as
+//! `bvh8` and `embree-medium` do). `bvh8-packets` is the registry's (packets that carry few
+//! rays handed to the single-ray walk, `PacketFloors::MEASURED`); `bvh8-packets-all` walks
+//! every packet as one; `RB_FLOORS=8:2,6:3` adds `bvh8-packets` with other `node:tri4` floors,
+//! labelled `floors-8:2` and so on (name them in `RB_ONLY` too when it is set).
 //!
 //! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
 //! CPU without AVX-512 the two are the same code. `RB_ONLY=embree-medium,bvh8` keeps only the
