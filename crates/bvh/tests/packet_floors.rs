@@ -22,12 +22,20 @@ fn packets(floors: PacketFloors) -> WideParams {
 /// Rays per window: the first packet of each is always walked as a packet.
 const WINDOW: usize = 256;
 
-/// Camera rays from outside and from inside each scene, and shadow rays from their hits.
-fn ray_sets(bvh: &Bvh8, scene: &scenes::Scene) -> Vec<Vec<Ray>> {
-    camera_ray_sets(scene, 6_000)
+/// The tree of a generated scene with `floors`, and its ray sets: camera rays from outside and
+/// from inside, and shadow rays from their hits. `None` (said) without the packet walk.
+fn tree_and_rays(spec: &str, seed: u64, floors: PacketFloors) -> Option<(Bvh8, Vec<Vec<Ray>>)> {
+    let scene = scenes::generate(spec, seed).expect("generates");
+    let bvh = Bvh8::build(scene.mesh.clone(), &packets(floors)).expect("builds");
+    if !bvh.packet_walk() {
+        eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to check");
+        return None;
+    }
+    let rays = camera_ray_sets(&scene, 6_000)
         .into_iter()
-        .chain(shadow_ray_sets(scene, bvh, 6_000))
-        .collect()
+        .chain(shadow_ray_sets(&scene, &bvh, 6_000))
+        .collect();
+    Some((bvh, rays))
 }
 
 #[test]
@@ -39,13 +47,10 @@ fn packets_under_the_floors_are_traced_ray_by_ray() {
     };
     let (mut handed, mut ties_in_packets) = (0usize, 0usize);
     for spec in ["city", "plane:quads=64", "teapot-in-stadium"] {
-        let scene = scenes::generate(spec, 3).expect("generates");
-        let bvh = Bvh8::build(scene.mesh.clone(), &packets(never)).expect("builds");
-        if !bvh.packet_walk() {
-            eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to check");
+        let Some((bvh, ray_sets)) = tree_and_rays(spec, 3, never) else {
             return;
-        }
-        for rays in ray_sets(&bvh, &scene) {
+        };
+        for rays in ray_sets {
             let prepared = bvh.prepare_coherent_rays(&rays).expect("valid rays");
             let mut hits = vec![None; rays.len()];
             bvh.intersect_prepared(&rays, &prepared, 0, &mut hits);
@@ -77,14 +82,10 @@ fn packets_under_the_floors_are_traced_ray_by_ray() {
 #[test]
 fn windows_decide_alike_in_one_call_and_in_chunks() {
     for spec in ["city", "sphere:triangles=60000", "grass"] {
-        let scene = scenes::generate(spec, 5).expect("generates");
-        let bvh =
-            Bvh8::build(scene.mesh.clone(), &packets(PacketFloors::MEASURED)).expect("builds");
-        if !bvh.packet_walk() {
-            eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to check");
+        let Some((bvh, ray_sets)) = tree_and_rays(spec, 5, PacketFloors::MEASURED) else {
             return;
-        }
-        for rays in ray_sets(&bvh, &scene) {
+        };
+        for rays in ray_sets {
             let prepared = bvh.prepare_coherent_rays(&rays).expect("valid rays");
             let mut whole = vec![None; rays.len()];
             bvh.intersect_prepared(&rays, &prepared, 0, &mut whole);

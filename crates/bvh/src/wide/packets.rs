@@ -96,27 +96,57 @@ fn intersect_packets<const W: usize>(
     out: &mut [Option<Hit>],
     stack: &mut PacketStack,
 ) {
+    let single = |k, rays: &[Ray], out: &mut [Option<Hit>]| {
+        with_stack(|s| avx2::intersect_all(bvh, k, rays, out, s))
+    };
+    each_packet(
+        bvh,
+        blocks,
+        rays,
+        first,
+        out,
+        single,
+        |block, out, usage| {
+            let (packet, mut best) = packet::load(block);
+            if !bvh.tri4s().is_empty() {
+                packet::octant_groups(&packet, out.len(), |lanes, octant| {
+                    walk(bvh, &packet, lanes, octant, &mut best, stack, usage)
+                });
+            }
+            for (o, (prim, h)) in out.iter_mut().zip(best.hits()) {
+                *o = (prim != NO_PRIM).then(|| Hit::from_tri_hit(prim, h));
+            }
+        },
+    );
+}
+
+/// Traces `blocks` (the packets of `rays`, the batch from ray `first` on) into `out`, a
+/// packet at a time: ray by ray through `single` where the [`Switch`] says so, else through
+/// `packet`, which walks one block and reports what its walk shared.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn each_packet<const W: usize, T>(
+    bvh: &BvhWide<W>,
+    blocks: &[RayBlock],
+    rays: &[Ray],
+    first: usize,
+    out: &mut [T],
+    mut single: impl FnMut(avx2::Avx2Nodes, &[Ray], &mut [T]),
+    mut packet: impl FnMut(&RayBlock, &mut [T], &mut Usage),
+) {
     let mut switch = Switch::new(bvh, first);
     for ((block, out), rays) in blocks
         .iter()
         .zip(out.chunks_mut(PACKET))
         .zip(rays.chunks(PACKET))
     {
-        if let Some(single) = switch.ray_by_ray() {
-            with_stack(|s| avx2::intersect_all(bvh, single, rays, out, s));
+        if let Some(k) = switch.ray_by_ray() {
+            single(k, rays, out);
             continue;
         }
-        let (packet, mut best) = packet::load(block);
         let mut usage = Usage::default();
-        if !bvh.tri4s().is_empty() {
-            packet::octant_groups(&packet, out.len(), |lanes, octant| {
-                walk(bvh, &packet, lanes, octant, &mut best, stack, &mut usage)
-            });
-        }
+        packet(block, out, &mut usage);
         switch.walked(usage);
-        for (o, (prim, h)) in out.iter_mut().zip(best.hits()) {
-            *o = (prim != NO_PRIM).then(|| Hit::from_tri_hit(prim, h));
-        }
     }
 }
 
@@ -308,29 +338,29 @@ fn occluded_packets<const W: usize>(
     out: &mut [bool],
     stack: &mut PacketStack,
 ) {
-    let mut switch = Switch::new(bvh, first);
-    for ((block, out), rays) in blocks
-        .iter()
-        .zip(out.chunks_mut(PACKET))
-        .zip(rays.chunks(PACKET))
-    {
-        if let Some(single) = switch.ray_by_ray() {
-            with_stack(|s| avx2::occluded_all(bvh, single, rays, out, s));
-            continue;
-        }
-        let (packet, mut best) = packet::load(block);
-        let mut done = 0u16;
-        let mut usage = Usage::default();
-        if !bvh.tri4s().is_empty() {
-            packet::octant_groups(&packet, out.len(), |lanes, octant| {
-                done |= walk_any(bvh, &packet, lanes, octant, &mut best, stack, &mut usage)
-            });
-        }
-        switch.walked(usage);
-        for (lane, o) in out.iter_mut().enumerate() {
-            *o = done >> lane & 1 == 1;
-        }
-    }
+    let single = |k, rays: &[Ray], out: &mut [bool]| {
+        with_stack(|s| avx2::occluded_all(bvh, k, rays, out, s))
+    };
+    each_packet(
+        bvh,
+        blocks,
+        rays,
+        first,
+        out,
+        single,
+        |block, out, usage| {
+            let (packet, mut best) = packet::load(block);
+            let mut done = 0u16;
+            if !bvh.tri4s().is_empty() {
+                packet::octant_groups(&packet, out.len(), |lanes, octant| {
+                    done |= walk_any(bvh, &packet, lanes, octant, &mut best, stack, usage)
+                });
+            }
+            for (lane, o) in out.iter_mut().enumerate() {
+                *o = done >> lane & 1 == 1;
+            }
+        },
+    );
 }
 
 /// The any-hit walk of the `active` lanes, whose directions all lie in `octant`; returns the
