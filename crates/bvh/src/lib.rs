@@ -28,8 +28,8 @@ pub use build::SpatialSplits;
 pub use build::reinsert::{ReinsertStats, Reinsertion};
 pub use node::{ChildRef, MAX_DEPTH, Node};
 pub use wide::{
-    Bvh4, Bvh8, Bvh8Compressed, Bvh8Compressed16, BvhQuantized, BvhWide, Collapse, NodeFormat,
-    NodeSimd, PacketFloors, WideParams,
+    Bvh4, Bvh8, Bvh8Compressed, Bvh8Compressed16, Bvh16, BvhQuantized, BvhWide, Collapse,
+    NodeFormat, NodeSimd, PacketFloors, WideParams,
 };
 
 use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, Walk};

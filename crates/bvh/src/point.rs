@@ -18,7 +18,7 @@
 use crate::Bvh;
 use crate::node::{ChildRef, MAX_DEPTH, Node};
 use crate::simd::F4;
-use crate::wide::{STACK, WideNode, quad};
+use crate::wide::{WideNode, quad, with_stack};
 use raybench_accel::{CounterSink, Nearest, PointHit};
 use raybench_geom::Tri4;
 use raybench_geom::{Aabb, TriangleMesh, Vec3, box_distance_squared};
@@ -111,7 +111,7 @@ pub(crate) fn closest_point_binary<C: CounterSink>(
                 }
             }
         }
-        next = pop_within(&stack, &mut sp, nearest.bound_d2());
+        next = pop_within(stack.as_slice(), &mut sp, nearest.bound_d2());
         if next.is_none() {
             return nearest.into_hit();
         }
@@ -188,37 +188,38 @@ pub(crate) fn closest_point_wide<const W: usize, C: CounterSink>(
         return None;
     }
     let splat = SplatPoint::new(p);
-    // As deep as the ray walk's stack: a node pushes at most `MAX_WIDTH - 1`, one per level.
-    let mut stack = [(ChildRef::default(), 0f32); STACK];
-    let mut sp = 0;
-    let mut next = Some(bvh.root);
-    let mut kids = [(ChildRef::default(), 0f32); W];
-    loop {
-        while let Some(r) = next.take() {
-            if r.is_leaf() {
-                c.leaf();
-                wide_leaf(bvh, r, p, &mut nearest, c);
-                break;
+    // The ray walk's per-thread stack (as deep as any walk needs), not one cleared per query.
+    with_stack(|stack| {
+        let mut sp = 0;
+        let mut next = Some(bvh.root);
+        let mut kids = [(ChildRef::default(), 0f32); W];
+        loop {
+            while let Some(r) = next.take() {
+                if r.is_leaf() {
+                    c.leaf();
+                    wide_leaf(bvh, r, p, &mut nearest, c);
+                    break;
+                }
+                c.node();
+                let n = &bvh.nodes[r.index as usize];
+                let d = wide_child_distances(&splat, n);
+                let len = children_within(n, &d, nearest.bound_d2(), &mut kids);
+                if len == 0 {
+                    break;
+                }
+                // Farthest pushed first, so the nearest pushed one is popped first.
+                for &entry in kids[1..len].iter().rev() {
+                    stack[sp] = entry;
+                    sp += 1;
+                }
+                next = Some(kids[0].0);
             }
-            c.node();
-            let n = &bvh.nodes[r.index as usize];
-            let d = wide_child_distances(&splat, n);
-            let len = children_within(n, &d, nearest.bound_d2(), &mut kids);
-            if len == 0 {
-                break;
+            next = pop_within(stack.as_slice(), &mut sp, nearest.bound_d2());
+            if next.is_none() {
+                return nearest.into_hit();
             }
-            // Farthest pushed first, so the nearest pushed one is popped first.
-            for &entry in kids[1..len].iter().rev() {
-                stack[sp] = entry;
-                sp += 1;
-            }
-            next = Some(kids[0].0);
         }
-        next = pop_within(&stack, &mut sp, nearest.bound_d2());
-        if next.is_none() {
-            return nearest.into_hit();
-        }
-    }
+    })
 }
 
 /// The `count` used lanes of the leaf's `Tri4`s, one exact distance each.

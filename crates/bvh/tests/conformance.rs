@@ -1,6 +1,6 @@
 //! The shared conformance suite for every BVH variant, `validate()` after every build.
 
-use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, BvhWide, Collapse, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh16, BvhParams, BvhWide, Collapse, WideParams};
 use raybench_testkit::conformance;
 
 fn check(params: BvhParams) {
@@ -97,8 +97,13 @@ fn four_wide_conforms() {
     wide_conforms_at::<4>();
 }
 
+#[test]
+fn sixteen_wide_conforms() {
+    wide_conforms_at::<16>();
+}
+
 /// A tree is built only with its own width (the knob in the report is the tree's shape), and
-/// only 4 or 8 wide.
+/// only 4, 8 or 16 wide.
 #[test]
 fn a_width_other_than_the_trees_is_refused() {
     use raybench_accel::{Accel, BuildError};
@@ -107,7 +112,7 @@ fn a_width_other_than_the_trees_is_refused() {
         Bvh4::build(mesh.clone(), &WideParams::for_width(8)).map(|_| ()),
         Bvh8::build(mesh.clone(), &WideParams::for_width(4)).map(|_| ()),
         // Widths the node tests and stacks are not made for, even with matching knobs.
-        BvhWide::<16>::build(mesh.clone(), &WideParams::for_width(16)).map(|_| ()),
+        BvhWide::<12>::build(mesh.clone(), &WideParams::for_width(12)).map(|_| ()),
         BvhWide::<6>::build(mesh.clone(), &WideParams::for_width(6)).map(|_| ()),
     ] {
         assert!(matches!(r, Err(BuildError::Unsupported(_))), "{r:?}");
@@ -209,6 +214,7 @@ fn wide_trees_are_the_same_with_one_and_two_threads() {
     let mesh = raybench_testkit::generated("teapot:triangles=20000", 1);
     check::<8>(&mesh);
     check::<4>(&mesh);
+    check::<16>(&mesh);
 }
 
 /// The SSE kernels (what a CPU without AVX2 runs) answer like the AVX2 ones, at width `W`:
@@ -279,6 +285,8 @@ fn avx2_only_conforms_at<const W: usize>() {
 fn wide_avx2_only_kernel_conforms() {
     avx2_only_conforms_at::<8>();
     avx2_only_conforms_at::<4>();
+    // Sixteen lanes: two 8-lane AVX2 passes instead of the one AVX-512 pass.
+    avx2_only_conforms_at::<16>();
 }
 
 #[test]
@@ -289,6 +297,13 @@ fn wide_sse_kernel_conforms_and_matches_the_default() {
 #[test]
 fn four_wide_sse_kernel_conforms_and_matches_the_default() {
     sse_matches_avx2_at::<4>();
+}
+
+/// At 16 wide the default kernel is one 16-lane AVX-512 pass where the CPU has AVX-512F: the
+/// SSE kernel's four passes answer and count as it does, ray for ray.
+#[test]
+fn sixteen_wide_sse_kernel_conforms_and_matches_the_default() {
+    sse_matches_avx2_at::<16>();
 }
 
 #[test]
@@ -344,6 +359,8 @@ fn wide_point_queries_conform() {
         let counts = point_conformance::<Bvh4>(&params, &|b, m| b.validate(m));
         assert_eq!(counts.mismatch, 0, "{params:?}");
     }
+    let counts = point_conformance::<Bvh16>(&WideParams::for_width(16), &|b, m| b.validate(m));
+    assert_eq!(counts.mismatch, 0);
 }
 
 #[test]
@@ -426,6 +443,7 @@ fn packet_walk_conforms() {
     }
     at::<8>();
     at::<4>();
+    at::<16>();
 }
 
 /// Camera rays in scanline order, as the `primary` workload makes them, on scenes of every kind and

@@ -11,11 +11,11 @@ use raybench_geom::Aabb;
 /// interior nodes (a subtree's triangles are one range of the builder's records), whether
 /// empty slots are filled, and the SAH-optimal plan of every node's children (none for the
 /// greedy collapse).
-pub(super) struct Binary<'a> {
+pub(super) struct Binary<'a, const W: usize> {
     nodes: &'a [Node],
     sizes: Vec<u32>,
     fill_slots: bool,
-    plan: Option<Plan>,
+    plan: Option<Plan<W>>,
 }
 
 /// Leaves of more triangles than this (one `Tri4`) may be split to fill a node's empty slots.
@@ -25,14 +25,14 @@ const SPLIT_LEAVES_ABOVE: u32 = 4;
 /// (measured: see docs/experiments.md, "collapse on rayon").
 const PARALLEL_COLLAPSE: usize = 4096;
 
-impl Binary<'_> {
-    /// `optimal`: the width and the builder's prices to plan the children with (see
-    /// `optimal.rs`), or `None` for the greedy collapse.
+impl<const W: usize> Binary<'_, W> {
+    /// `optimal`: the builder's prices to plan the children with (see `optimal.rs`), or
+    /// `None` for the greedy collapse.
     pub(super) fn new<'a>(
         nodes: &'a [Node],
         fill_slots: bool,
-        optimal: Option<(usize, &BvhParams)>,
-    ) -> Binary<'a> {
+        optimal: Option<&BvhParams>,
+    ) -> Binary<'a, W> {
         let mut sizes = vec![0u32; nodes.len()];
         // Children follow their parent in the depth-first array: fill in sizes bottom-up.
         for i in (0..nodes.len()).rev() {
@@ -48,7 +48,7 @@ impl Binary<'_> {
                 })
                 .sum();
         }
-        let plan = optimal.map(|(width, p)| Plan::new(nodes, width, p));
+        let plan = optimal.map(|p| Plan::new(nodes, p));
         Binary {
             nodes,
             sizes,
@@ -71,7 +71,7 @@ impl Binary<'_> {
     /// ties: deterministic) until there are `W` or only leaves remain. Slots still empty are
     /// filled by splitting the largest leaves of more than one `Tri4`. Children stay in the
     /// order of their triangles.
-    fn open<const W: usize>(
+    fn open(
         &self,
         refs: &mut [PrimRef],
         start: u32,
@@ -80,7 +80,7 @@ impl Binary<'_> {
         let n = &self.nodes[r.index as usize];
         // A fixed array, not a Vec: one wide node per call, no allocation.
         let (mut kids, mut len) = match &self.plan {
-            Some(plan) => plan.children::<W>(self.nodes, r),
+            Some(plan) => plan.children(self.nodes, r),
             None => {
                 let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
                 kids[0] = (n.child[0], n.child_bounds(0));
@@ -188,7 +188,7 @@ fn split_leaf(refs: &mut [PrimRef], first: u32) -> [(ChildRef, Aabb); 2] {
 /// in the final array, in parallel too. The nodes and their order are the ones one thread
 /// makes.
 pub(super) fn collapse_tree<const W: usize>(
-    b: &Binary,
+    b: &Binary<W>,
     refs: &mut [PrimRef],
     r: ChildRef,
 ) -> (Vec<WideNode<W>>, ChildRef) {
@@ -232,14 +232,14 @@ impl<const W: usize> Piece<W> {
 /// Collapses the binary subtree `r`, whose triangles are `refs` (the first of them record
 /// `start`), into a [`Piece`]: on this thread below [`PARALLEL_COLLAPSE`] triangles, else with
 /// its children's subtrees on rayon.
-fn piece<const W: usize>(b: &Binary, refs: &mut [PrimRef], start: u32, r: ChildRef) -> Piece<W> {
+fn piece<const W: usize>(b: &Binary<W>, refs: &mut [PrimRef], start: u32, r: ChildRef) -> Piece<W> {
     use rayon::prelude::*;
     if r.is_leaf() || refs.len() < PARALLEL_COLLAPSE {
         let mut nodes = Vec::new();
         let root = collapse(b, refs, start, r, &mut nodes);
         return Piece::Local { nodes, root };
     }
-    let (kids, len) = b.open::<W>(refs, start, r);
+    let (kids, len) = b.open(refs, start, r);
     let mut node = WideNode::empty();
     let mut jobs = Vec::with_capacity(len);
     for (slot, (child, bounds, mine, first)) in
@@ -310,7 +310,7 @@ fn place<const W: usize>(piece: Piece<W>, out: &mut [WideNode<W>], base: u32) ->
 ///
 /// [`number_tri4s`]: super::pack::number_tri4s
 fn collapse<const W: usize>(
-    b: &Binary,
+    b: &Binary<W>,
     refs: &mut [PrimRef],
     start: u32,
     r: ChildRef,
@@ -319,7 +319,7 @@ fn collapse<const W: usize>(
     if r.is_leaf() {
         return r;
     }
-    let (kids, len) = b.open::<W>(refs, start, r);
+    let (kids, len) = b.open(refs, start, r);
     let at = out.len();
     out.push(WideNode::empty());
     for (slot, (child, bounds, mine, first)) in
@@ -336,8 +336,8 @@ fn collapse<const W: usize>(
 
 /// The children of a wide node (`kids`, in slot order) with their triangles: consecutive
 /// ranges of `refs`, whose first record is `start`; each with the index of its first record.
-fn child_ranges<'a>(
-    b: &'a Binary,
+fn child_ranges<'a, const W: usize>(
+    b: &'a Binary<W>,
     kids: &'a [(ChildRef, Aabb)],
     refs: &'a mut [PrimRef],
     start: u32,

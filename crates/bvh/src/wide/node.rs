@@ -3,10 +3,10 @@
 use crate::node::ChildRef;
 use raybench_geom::{Aabb, Vec3};
 
-/// One wide node of `W` children (4 or 8): child boxes per axis as `[min or max][slot]`, so
-/// one SIMD load fetches a plane of four or eight children; unused slots hold an empty box
-/// (`min = +inf`, `max = -inf`) that no ray enters. 8 wide: 256 bytes, four cache lines;
-/// 4 wide: 128 bytes, two.
+/// One wide node of `W` children (4, 8 or 16): child boxes per axis as `[min or max][slot]`,
+/// so one SIMD load fetches a plane of four, eight or sixteen children; unused slots hold an
+/// empty box (`min = +inf`, `max = -inf`) that no ray enters. 16 wide: 512 bytes, eight cache
+/// lines; 8 wide: 256 bytes, four; 4 wide: 128 bytes, two.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub struct WideNode<const W: usize> {
@@ -15,6 +15,7 @@ pub struct WideNode<const W: usize> {
     pub child: [ChildRef; W],
 }
 
+const _: () = assert!(std::mem::size_of::<WideNode<16>>() == 512);
 const _: () = assert!(std::mem::size_of::<WideNode<8>>() == 256);
 const _: () = assert!(std::mem::size_of::<WideNode<4>>() == 128);
 

@@ -40,41 +40,39 @@ const PARALLEL_PLAN: usize = 1024;
 /// at most that many children from each of its two); and how its own wide node splits its
 /// `W` slots between its children.
 #[derive(Clone, Copy)]
-struct Entry {
-    cost: [f64; MAX_WIDTH],
-    cover: [(u8, u8); MAX_WIDTH],
+struct Entry<const W: usize> {
+    cost: [f64; W],
+    cover: [(u8, u8); W],
     own: (u8, u8),
 }
 
-const EMPTY: Entry = Entry {
-    cost: [0.0; MAX_WIDTH],
-    cover: [(0, 0); MAX_WIDTH],
-    own: (0, 0),
-};
-
-/// The entries of every binary interior node, in the binary tree's order.
-pub(super) struct Plan {
-    entries: Vec<Entry>,
+impl<const W: usize> Entry<W> {
+    const EMPTY: Entry<W> = Entry {
+        cost: [0.0; W],
+        cover: [(0, 0); W],
+        own: (0, 0),
+    };
 }
 
-impl Plan {
-    /// The plan for `width`-wide nodes over the binary tree `nodes` (depth-first from the
-    /// root at index 0: a node's left subtree right after it, then its right subtree).
-    pub(super) fn new(nodes: &[Node], width: usize, p: &BvhParams) -> Plan {
-        let mut entries = vec![EMPTY; nodes.len()];
+/// The entries of every binary interior node, in the binary tree's order.
+pub(super) struct Plan<const W: usize> {
+    entries: Vec<Entry<W>>,
+}
+
+impl<const W: usize> Plan<W> {
+    /// The plan for `W`-wide nodes over the binary tree `nodes` (depth-first from the root at
+    /// index 0: a node's left subtree right after it, then its right subtree).
+    pub(super) fn new(nodes: &[Node], p: &BvhParams) -> Plan<W> {
+        let mut entries = vec![Entry::EMPTY; nodes.len()];
         if !nodes.is_empty() {
-            plan(nodes, 0, &mut entries, width, p);
+            plan(nodes, 0, &mut entries, p);
         }
         Plan { entries }
     }
 
     /// The children of the wide node made from binary interior node `r`, in the order of
     /// their triangles: binary interior nodes (each a wide node in turn) and leaves.
-    pub(super) fn children<const W: usize>(
-        &self,
-        nodes: &[Node],
-        r: ChildRef,
-    ) -> ([(ChildRef, Aabb); W], usize) {
+    pub(super) fn children(&self, nodes: &[Node], r: ChildRef) -> ([(ChildRef, Aabb); W], usize) {
         let mut kids = [(ChildRef::default(), Aabb::EMPTY); W];
         let mut len = 0;
         let (a, b) = self.entries[r.index as usize].own;
@@ -86,7 +84,7 @@ impl Plan {
         (kids, len)
     }
 
-    fn cover<const W: usize>(
+    fn cover(
         &self,
         nodes: &[Node],
         (r, bounds): (ChildRef, Aabb),
@@ -126,7 +124,7 @@ impl Plan {
 
 /// Fills the entries of the subtree of binary interior node `at`: `entries` is exactly that
 /// subtree's range of the binary tree, so `entries[0]` is `at`'s entry.
-fn plan(nodes: &[Node], at: usize, entries: &mut [Entry], width: usize, p: &BvhParams) {
+fn plan<const W: usize>(nodes: &[Node], at: usize, entries: &mut [Entry<W>], p: &BvhParams) {
     let node = &nodes[at];
     // A child's subtree starts at its index; the left one right after `at`.
     let (left, right) = (node.child[0], node.child[1]);
@@ -138,14 +136,14 @@ fn plan(nodes: &[Node], at: usize, entries: &mut [Entry], width: usize, p: &BvhP
     {
         let (left_part, right_part) = entries[1..].split_at_mut(right_offset - 1);
         let big = left_part.len().min(right_part.len()) >= PARALLEL_PLAN;
-        let go_left = |part: &mut [Entry]| {
+        let go_left = |part: &mut [Entry<W>]| {
             if !left.is_leaf() {
-                plan(nodes, left.index as usize, part, width, p);
+                plan(nodes, left.index as usize, part, p);
             }
         };
-        let go_right = |part: &mut [Entry]| {
+        let go_right = |part: &mut [Entry<W>]| {
             if !right.is_leaf() {
-                plan(nodes, right.index as usize, part, width, p);
+                plan(nodes, right.index as usize, part, p);
             }
         };
         if big {
@@ -155,10 +153,10 @@ fn plan(nodes: &[Node], at: usize, entries: &mut [Entry], width: usize, p: &BvhP
             go_right(right_part);
         }
     }
-    let side = |c: usize| -> [f64; MAX_WIDTH] {
+    let side = |c: usize| -> [f64; W] {
         let r = node.child[c];
         if r.is_leaf() {
-            [leaf_cost(node.child_bounds(c).surface_area(), r.count, p); MAX_WIDTH]
+            [leaf_cost(node.child_bounds(c).surface_area(), r.count, p); W]
         } else {
             entries[r.index as usize - at].cost
         }
@@ -167,7 +165,7 @@ fn plan(nodes: &[Node], at: usize, entries: &mut [Entry], width: usize, p: &BvhP
     // The cheapest split of `j` slots between the two children, j = 2 ..= width.
     // Starting from one slot on the left, so every split names both children's slots.
     let mut split = [(0.0, (0u8, 0u8)); MAX_WIDTH + 1];
-    for (j, s) in split.iter_mut().enumerate().take(width + 1).skip(2) {
+    for (j, s) in split.iter_mut().enumerate().take(W + 1).skip(2) {
         *s = (l[0] + r[j - 2], (1, (j - 1) as u8));
         for k in 2..j {
             let c = l[k - 1] + r[j - k - 1];
@@ -181,9 +179,9 @@ fn plan(nodes: &[Node], at: usize, entries: &mut [Entry], width: usize, p: &BvhP
         .union(&node.child_bounds(1))
         .surface_area();
     let e = &mut entries[0];
-    e.own = split[width].1;
-    let mut best = (area * p.traversal_cost as f64 + split[width].0, (0, 0));
-    for (i, s) in split.iter().enumerate().take(width + 1).skip(1) {
+    e.own = split[W].1;
+    let mut best = (area * p.traversal_cost as f64 + split[W].0, (0, 0));
+    for (i, s) in split.iter().enumerate().take(W + 1).skip(1) {
         if i >= 2 && s.0 < best.0 {
             best = *s;
         }
@@ -202,6 +200,9 @@ mod tests {
     use crate::build::{Flat, build};
     use crate::wide::{BvhWide, Collapse, WideParams};
     use raybench_accel::Accel;
+
+    /// The exhaustive enumeration below is exponential in the width: 8-wide plans.
+    const WIDTH: usize = 8;
 
     fn binary(spec: &str, p: &BvhParams) -> Flat {
         let mesh = raybench_testkit::generated(spec, 3);
@@ -238,11 +239,11 @@ mod tests {
     fn cheapest_node(nodes: &[Node], r: ChildRef, p: &BvhParams) -> f64 {
         let n = &nodes[r.index as usize];
         let area = n.child_bounds(0).union(&n.child_bounds(1)).surface_area();
-        let a = covers(nodes, n.child[0], n.child_bounds(0), MAX_WIDTH - 1, p);
-        let b = covers(nodes, n.child[1], n.child_bounds(1), MAX_WIDTH - 1, p);
+        let a = covers(nodes, n.child[0], n.child_bounds(0), WIDTH - 1, p);
+        let b = covers(nodes, n.child[1], n.child_bounds(1), WIDTH - 1, p);
         let mut best = f64::INFINITY;
         for (ka, ca) in a.iter().enumerate().skip(1) {
-            for cb in b.iter().skip(1).take(MAX_WIDTH - ka) {
+            for cb in b.iter().skip(1).take(WIDTH - ka) {
                 best = best.min(ca + cb);
             }
         }
@@ -290,7 +291,7 @@ mod tests {
         ] {
             let flat = binary(spec, &p);
             assert!(flat.nodes.len() > 20, "{spec}: {} nodes", flat.nodes.len());
-            let plan = Plan::new(&flat.nodes, MAX_WIDTH, &p);
+            let plan = Plan::<WIDTH>::new(&flat.nodes, &p);
             for i in 0..flat.nodes.len().min(60) {
                 let r = ChildRef {
                     index: i as u32,
@@ -324,7 +325,7 @@ mod tests {
             optimal.validate(&mesh).expect("the tree validates");
             let p = &optimal.params().binary;
             let flat = build(&mesh, p).expect("builds");
-            let planned = Plan::new(&flat.nodes, W, p).cost_as_node(flat.root);
+            let planned = Plan::<W>::new(&flat.nodes, p).cost_as_node(flat.root);
             let (built, greedy) = (wide_cost(&optimal, p), wide_cost(&greedy, p));
             assert!(
                 close(planned, built),
@@ -368,7 +369,7 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .expect("a pool");
-            pool.install(|| Plan::new(&flat.nodes, MAX_WIDTH, &p))
+            pool.install(|| Plan::<WIDTH>::new(&flat.nodes, &p))
         };
         let (one, two) = (plan(1), plan(2));
         assert_eq!(one.entries.len(), two.entries.len());

@@ -1,6 +1,5 @@
 //! The knobs of a wide BVH.
 
-use super::MAX_WIDTH;
 use crate::BvhParams;
 use serde::Serialize;
 
@@ -141,7 +140,7 @@ impl Default for WideParams {
                 max_leaf_size: 8,
                 ..BvhParams::binned()
             },
-            width: MAX_WIDTH as u32,
+            width: 8,
             node_simd: NodeSimd::Auto,
             // Measured: see docs/experiments.md, "SAH-optimal collapse".
             collapse: Collapse::Optimal,

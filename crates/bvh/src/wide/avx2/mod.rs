@@ -6,8 +6,10 @@
 //! a lane is NaN (`0 * inf` for a ray in a box's face plane, docs/validation.md, B1), the compare
 //! is ordered (false on NaN). [`Avx2Nodes`] can only be made by [`Avx2Nodes::detect`], after the
 //! CPU has reported AVX2, which is what makes calling the `#[target_feature]` code sound. AVX-512
-//! adds no arithmetic an 8-lane f32 test needs, so there is no AVX-512 kernel. What it adds is
-//! registers: 32 vector registers instead of 16. The walk keeps ten splatted values of the ray live
+//! adds no arithmetic an 8-lane f32 test needs; a 16-wide node takes one 16-lane pass per axis
+//! where the CPU has AVX-512F ([`test_sixteen`], the same operations lane for lane, so the same
+//! answers as two 8-lane passes). What AVX-512 adds to every width is registers: 32 vector
+//! registers instead of 16. The walk keeps ten splatted values of the ray live
 //! (origin, direction, inverse direction, `t_min`); with AVX2's sixteen, the compiler spills them
 //! and reloads six at every node. The batch loops are therefore compiled twice (`batch_loops`),
 //! once with AVX-512F and VL enabled; the same arithmetic runs in both, so the answers and counters
@@ -121,6 +123,43 @@ fn test_octs<const W: usize>(
     (mask, entry)
 }
 
+/// The sixteen children of a 16-wide node in one 16-lane pass per axis (AVX-512F): the
+/// arithmetic of [`test_octs`], lane for lane. The ray's splats are widened here; inlined into
+/// the batch loops, the widening is the same every node, so it is hoisted out of the walk.
+#[target_feature(enable = "avx2,avx512f")]
+#[inline]
+fn test_sixteen<const W: usize>(
+    r: &Avx2Ray,
+    n: &WideNode<W>,
+    t_min: f32,
+    t_max: f32,
+) -> (u32, [f32; W]) {
+    assert!(W == 16, "a 16-lane test of a {W}-wide node");
+    let mut t0 = _mm512_set1_ps(t_min);
+    let mut t1 = _mm512_set1_ps(t_max);
+    for a in 0..3 {
+        let near = &n.planes[a][r.near[a] as usize];
+        let far = &n.planes[a][!r.near[a] as usize];
+        let origin = _mm512_broadcastss_ps(_mm256_castps256_ps128(r.origin[a]));
+        let inv = _mm512_broadcastss_ps(_mm256_castps256_ps128(r.inv[a]));
+        // SAFETY: W is 16 (asserted above), so each row is 16 contiguous initialised f32s;
+        // `loadu` has no alignment requirement.
+        let (near, far) = unsafe {
+            (
+                _mm512_loadu_ps(near.as_ptr()),
+                _mm512_loadu_ps(far.as_ptr()),
+            )
+        };
+        t0 = _mm512_max_ps(_mm512_mul_ps(_mm512_sub_ps(near, origin), inv), t0);
+        t1 = _mm512_min_ps(_mm512_mul_ps(_mm512_sub_ps(far, origin), inv), t1);
+    }
+    let mask = u32::from(_mm512_cmp_ps_mask::<_CMP_LE_OQ>(t0, t1));
+    let mut entry = [0.0f32; W];
+    // SAFETY: `entry` is 16 writable f32s (W is 16); `storeu` has no alignment requirement.
+    unsafe { _mm512_storeu_ps(entry.as_mut_ptr(), t0) };
+    (mask, entry)
+}
+
 impl<const W: usize> NodeKernel<W> for Avx2Nodes {
     type Ray = Avx2Ray;
 
@@ -132,9 +171,12 @@ impl<const W: usize> NodeKernel<W> for Avx2Nodes {
 
     #[inline(always)]
     fn test(self, ray: &Avx2Ray, n: &WideNode<W>, t_min: f32, t_max: f32) -> (u32, [f32; W]) {
-        // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.
+        // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU, and says
+        // `wide_registers` only when it also saw AVX-512F (and VL).
         unsafe {
-            if W.is_multiple_of(8) {
+            if W == 16 && self.wide_registers {
+                test_sixteen(ray, n, t_min, t_max)
+            } else if W.is_multiple_of(8) {
                 test_octs(ray, n, t_min, t_max)
             } else {
                 // 4 wide: the SSE kernel's arithmetic on the low halves of the splatted ray.

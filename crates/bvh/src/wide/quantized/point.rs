@@ -6,8 +6,7 @@
 
 use super::BvhQuantized;
 use super::node::{Plane, QWIDTH};
-use crate::node::ChildRef;
-use crate::wide::STACK;
+use crate::node::{ChildRef, MAX_DEPTH};
 use raybench_accel::{CounterSink, Nearest, PointHit};
 use raybench_geom::{Vec3, box_distance_squared};
 
@@ -23,7 +22,8 @@ impl<P: Plane> BvhQuantized<P> {
         {
             return None;
         }
-        let mut stack = [(ChildRef::default(), 0f32); STACK];
+        // A node pushes at most `QWIDTH - 1` children, one node a level.
+        let mut stack = [(ChildRef::default(), 0f32); (QWIDTH - 1) * MAX_DEPTH + 1];
         let mut sp = 0;
         let mut next = Some(self.root);
         loop {
