@@ -241,32 +241,32 @@ pub(super) fn inserted<const W: usize>(
     stack[*sp].0
 }
 
-/// Checks `order` against [`inserted`] on every mask of eight children whose count lies in
-/// `counts`, with distances drawn from a few values (many exactly equal, -0 and +0 among them,
-/// the others far more than 8 ulps apart): the same child first, and the same children with the
-/// same distances pushed in the same order. Returns the cases checked.
+/// Checks `order` against [`inserted`] on the masks of `W` children in `masks`, with distances
+/// drawn from a few values (many exactly equal, -0 and +0 among them, the others far more than 16
+/// ulps apart): the same child first, and the same children with the same distances pushed in
+/// the same order. Returns the cases checked.
 #[cfg(test)]
-pub(super) fn check_against_insertion(
-    counts: std::ops::RangeInclusive<u32>,
-    order: impl Fn(&[ChildRef; 8], u32, &[f32; 8], &mut Stack, &mut usize) -> ChildRef,
+pub(super) fn check_against_insertion<const W: usize>(
+    masks: impl Iterator<Item = u32>,
+    order: impl Fn(&[ChildRef; W], u32, &[f32; W], &mut Stack, &mut usize) -> ChildRef,
 ) -> usize {
     let values = [0.0f32, 0.5, -0.0, 1.0, 1.0e3, 3.25];
-    let child: [ChildRef; 8] = std::array::from_fn(|i| ChildRef {
+    let child: [ChildRef; W] = std::array::from_fn(|i| ChildRef {
         index: 100 + i as u32,
         count: 0,
     });
     let mut checked = 0;
-    for mask in (1u32..256).filter(|m| counts.contains(&m.count_ones())) {
+    let (mut a, mut b) = (new_stack(), new_stack());
+    for mask in masks {
         for seed in 0..25usize {
-            let entry: [f32; 8] =
+            let entry: [f32; W] =
                 std::array::from_fn(|i| values[(i * 7 + seed * 3 + i * seed) % values.len()]);
-            let (mut a, mut b) = (new_stack(), new_stack());
             let (mut sa, mut sb) = (0, 0);
             let first_a = inserted(&child, mask, &entry, &mut a, &mut sa);
             let first_b = order(&child, mask, &entry, &mut b, &mut sb);
-            assert_eq!(first_a, first_b, "mask {mask:08b}, distances {entry:?}");
-            assert_eq!(sa, sb, "mask {mask:08b}, distances {entry:?}");
-            assert_eq!(a[..sa], b[..sb], "mask {mask:08b}, distances {entry:?}");
+            assert_eq!(first_a, first_b, "mask {mask:016b}, distances {entry:?}");
+            assert_eq!(sa, sb, "mask {mask:016b}, distances {entry:?}");
+            assert_eq!(a[..sa], b[..sb], "mask {mask:016b}, distances {entry:?}");
             checked += 1;
         }
     }
@@ -299,7 +299,8 @@ mod tests {
     /// The short paths of [`nearest_first`] (one to three children) order as the insertion.
     #[test]
     fn the_short_paths_order_as_the_insertion() {
-        let checked = check_against_insertion(1..=3, nearest_first);
+        let masks = (1u32..256).filter(|m| (1..=3).contains(&m.count_ones()));
+        let checked = check_against_insertion::<8>(masks, nearest_first);
         assert_eq!(checked, (8 + 28 + 56) * 25);
     }
 }

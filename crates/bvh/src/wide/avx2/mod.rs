@@ -26,7 +26,7 @@ use super::walk::{Stack, nearest_first};
 use crate::node::ChildRef;
 use crate::simd::F4;
 use leaf::leaf_pairs;
-use order::nearest_first_sorted;
+use order::{nearest_first_sorted, nearest_first_sorted16};
 use raybench_accel::{CounterSink, Hit, NoCount};
 use raybench_geom::{Ray, Tri4, TriHit};
 use std::arch::x86_64::*;
@@ -198,7 +198,14 @@ impl<const W: usize> NodeKernel<W> for Avx2Nodes {
         // Up to three children, the short paths of `nearest_first` are cheaper than the
         // network's chain of stages (measured: see docs/experiments.md, "a sorting network for
         // nodes entering four or more children").
-        if W != 8 || mask.count_ones() < 4 {
+        if mask.count_ones() < 4 {
+            return nearest_first(child, mask, entry, stack, sp);
+        }
+        if W == 16 && self.wide_registers {
+            // SAFETY: `wide_registers` only after `detect` saw AVX-512F (and AVX2) on this CPU.
+            return unsafe { nearest_first_sorted16(child, mask, entry, stack, sp) };
+        }
+        if W != 8 {
             return nearest_first(child, mask, entry, stack, sp);
         }
         // SAFETY: an `Avx2Nodes` exists only after `detect` saw AVX2 on this CPU.

@@ -1,14 +1,14 @@
-//! The closest-hit walk's child ordering for 8-wide nodes where a ray enters four or more
+//! The closest-hit walk's child ordering for 8- and 16-wide nodes where a ray enters four or more
 //! children, without a branch per child: the insertion of `walk::nearest_first` mispredicts on
 //! such nodes, which are common where boxes overlap heavily (hair, triangle soups). The children
-//! are sorted in a bitonic network on one AVX2 register (Batcher 1968): six compare-exchange
-//! stages on eight 32-bit keys.
+//! are sorted in a bitonic network on one register (Batcher 1968): six compare-exchange stages on
+//! eight 32-bit keys in AVX2, ten on sixteen in AVX-512F.
 //!
 //! The keys are the entry distances' bits (non-negative floats order as integers; -0 is made +0)
-//! with the slot in the low three bits, and the children not entered get the largest key. So the
-//! order is the insertion's — nearest first, equal distances lower slot first — except that
-//! distances within 8 ulps of each other also count as equal. The stack keeps each child's exact
-//! distance, so the pops skip exactly what they skip after the insertion.
+//! with the slot in the low three (four) bits, and the children not entered get the largest key.
+//! So the order is the insertion's — nearest first, equal distances lower slot first — except
+//! that distances within 8 (16) ulps of each other also count as equal. The stack keeps each
+//! child's exact distance, so the pops skip exactly what they skip after the insertion.
 
 use crate::node::ChildRef;
 use crate::wide::walk::Stack;
@@ -78,6 +78,68 @@ pub(super) fn nearest_first_sorted<const W: usize>(
     child[(sorted[0] & 7) as usize]
 }
 
+/// One compare-exchange stage on sixteen keys: lane `i` meets lane `perm[i]`, and the lanes set
+/// in `hi` keep the larger key.
+#[target_feature(enable = "avx2,avx512f")]
+#[inline]
+fn stage16(keys: __m512i, perm: __m512i, hi: __mmask16) -> __m512i {
+    let other = _mm512_permutexvar_epi32(perm, keys);
+    let lo = _mm512_min_epu32(keys, other);
+    let high = _mm512_max_epu32(keys, other);
+    _mm512_mask_blend_epi32(hi, lo, high)
+}
+
+/// The sixteen keys in ascending order: sorted pairs, quadruples, eights, then the sixteen, each
+/// merge a reversed compare followed by half cleaners (as `sort8`, one size further).
+#[target_feature(enable = "avx2,avx512f")]
+#[inline]
+fn sort16(mut k: __m512i) -> __m512i {
+    let lanes = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    let xor = |x: i32| _mm512_xor_si512(lanes, _mm512_set1_epi32(x));
+    // Lane i meets lane i ^ x, x = 2^b (a half cleaner) or 2^(b+1) - 1 (a reversed compare); of
+    // the two, the lane with bit b set keeps the larger key.
+    const UPPER: [__mmask16; 4] = [0xaaaa, 0xcccc, 0xf0f0, 0xff00];
+    for size in 1..=4 {
+        k = stage16(k, xor((1 << size) - 1), UPPER[size - 1]);
+        for b in (0..size - 1).rev() {
+            k = stage16(k, xor(1 << b), UPPER[b]);
+        }
+    }
+    k
+}
+
+/// `walk::nearest_first` for a 16-wide node through the sixteen-key network: returns the
+/// nearest child in `mask` and pushes the others so that they pop nearest first.
+#[target_feature(enable = "avx2,avx512f")]
+#[inline]
+pub(super) fn nearest_first_sorted16<const W: usize>(
+    child: &[ChildRef; W],
+    mask: u32,
+    entry: &[f32; W],
+    stack: &mut Stack,
+    sp: &mut usize,
+) -> ChildRef {
+    assert!(W == 16, "a 16-key sort of a {W}-wide node");
+    debug_assert!(mask != 0 && mask < 1 << 16);
+    // SAFETY: W is 16 (asserted above): 16 initialised f32s; `loadu` has no alignment requirement.
+    let e = unsafe { _mm512_loadu_ps(entry.as_ptr()) };
+    // +0 turns -0 into +0, so every key is a non-negative float's bits.
+    let bits = _mm512_castps_si512(_mm512_add_ps(e, _mm512_setzero_ps()));
+    let slots = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    let keys = _mm512_or_si512(_mm512_andnot_si512(_mm512_set1_epi32(15), bits), slots);
+    let keys = _mm512_mask_mov_epi32(_mm512_set1_epi32(-1), mask as __mmask16, keys);
+    let mut sorted = [0u32; 16];
+    // SAFETY: `sorted` is 16 writable u32s; `storeu` has no alignment requirement.
+    unsafe { _mm512_storeu_si512(sorted.as_mut_ptr().cast(), sort16(keys)) };
+    let count = mask.count_ones() as usize;
+    for &key in sorted[1..count].iter().rev() {
+        let slot = (key & 15) as usize;
+        stack[*sp] = (child[slot], entry[slot]);
+        *sp += 1;
+    }
+    child[(sorted[0] & 15) as usize]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -91,10 +153,30 @@ mod tests {
             eprintln!("no AVX2 on this CPU: nothing to compare");
             return;
         }
-        let checked = check_against_insertion(4..=8, |child, mask, entry, stack, sp| {
+        let masks = (1u32..256).filter(|m| m.count_ones() >= 4);
+        let checked = check_against_insertion::<8>(masks, |child, mask, entry, stack, sp| {
             // SAFETY: AVX2 was detected above.
             unsafe { nearest_first_sorted(child, mask, entry, stack, sp) }
         });
         assert_eq!(checked, 163 * 25);
+    }
+
+    /// Masks of sixteen children with four or more set (every 7th, all counts from 4 to 16
+    /// among them), likewise.
+    #[test]
+    fn the_sixteen_key_network_orders_as_the_insertion() {
+        if !std::arch::is_x86_feature_detected!("avx512f") {
+            eprintln!("no AVX-512F on this CPU: nothing to compare");
+            return;
+        }
+        let masks = (1u32..1 << 16)
+            .step_by(7)
+            .chain([0xffff])
+            .filter(|m| m.count_ones() >= 4);
+        let checked = check_against_insertion::<16>(masks, |child, mask, entry, stack, sp| {
+            // SAFETY: AVX-512F (and so AVX2) was detected above.
+            unsafe { nearest_first_sorted16(child, mask, entry, stack, sp) }
+        });
+        assert!(checked > 8_000 * 25, "{checked}");
     }
 }
