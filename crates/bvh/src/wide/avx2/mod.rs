@@ -124,8 +124,8 @@ fn test_octs<const W: usize>(
 }
 
 /// The sixteen children of a 16-wide node in one 16-lane pass per axis (AVX-512F): the
-/// arithmetic of [`test_octs`], lane for lane. The ray's splats are widened here; inlined into
-/// the batch loops, the widening is the same every node, so it is hoisted out of the walk.
+/// arithmetic of [`test_octs`], lane for lane. The ray's 8-lane splats are widened here: the
+/// widening does not depend on the node, so inlined into a batch loop it can leave the walk.
 #[target_feature(enable = "avx2,avx512f")]
 #[inline]
 fn test_sixteen<const W: usize>(
