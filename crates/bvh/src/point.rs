@@ -111,7 +111,7 @@ pub(crate) fn closest_point_binary<C: CounterSink>(
                 }
             }
         }
-        next = pop_within(stack.as_slice(), &mut sp, nearest.bound_d2());
+        next = pop_within(&stack, &mut sp, nearest.bound_d2());
         if next.is_none() {
             return nearest.into_hit();
         }

@@ -1,6 +1,6 @@
 //! Wide BVHs — 8 children per node ([`Bvh8`]), 4 ([`Bvh4`]) or 16 ([`Bvh16`]) — collapsed from
-//! the binary SAH tree, traversed with one SIMD box test per node (see docs/results/ for where they stand
-//! against Embree).
+//! the binary SAH tree, traversed with one SIMD box test per node (see docs/results/ for where
+//! they stand against Embree).
 //!
 //! Collapse (`collapse.rs`): by default each wide node's children are chosen for the least SAH cost
 //! of the whole wide tree, by dynamic programming over the binary tree (`optimal.rs`,

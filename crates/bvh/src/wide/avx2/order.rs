@@ -69,13 +69,34 @@ pub(super) fn nearest_first_sorted<const W: usize>(
     let mut sorted = [0u32; 8];
     // SAFETY: `sorted` is 8 writable u32s; `storeu` has no alignment requirement.
     unsafe { _mm256_storeu_si256(sorted.as_mut_ptr().cast(), sort8(keys)) };
-    let count = mask.count_ones() as usize;
-    for &key in sorted[1..count].iter().rev() {
-        let slot = (key & 7) as usize;
+    push_sorted(
+        &sorted[..mask.count_ones() as usize],
+        7,
+        child,
+        entry,
+        stack,
+        sp,
+    )
+}
+
+/// The children of the sorted keys `sorted` (the entered ones, nearest first; the slot in the
+/// bits of `slot_bits`): pushes all but the first so that they pop nearest first, and returns
+/// the first.
+#[inline(always)]
+fn push_sorted<const W: usize>(
+    sorted: &[u32],
+    slot_bits: u32,
+    child: &[ChildRef; W],
+    entry: &[f32; W],
+    stack: &mut Stack,
+    sp: &mut usize,
+) -> ChildRef {
+    for &key in sorted[1..].iter().rev() {
+        let slot = (key & slot_bits) as usize;
         stack[*sp] = (child[slot], entry[slot]);
         *sp += 1;
     }
-    child[(sorted[0] & 7) as usize]
+    child[(sorted[0] & slot_bits) as usize]
 }
 
 /// One compare-exchange stage on sixteen keys: lane `i` meets lane `perm[i]`, and the lanes set
@@ -131,13 +152,14 @@ pub(super) fn nearest_first_sorted16<const W: usize>(
     let mut sorted = [0u32; 16];
     // SAFETY: `sorted` is 16 writable u32s; `storeu` has no alignment requirement.
     unsafe { _mm512_storeu_si512(sorted.as_mut_ptr().cast(), sort16(keys)) };
-    let count = mask.count_ones() as usize;
-    for &key in sorted[1..count].iter().rev() {
-        let slot = (key & 15) as usize;
-        stack[*sp] = (child[slot], entry[slot]);
-        *sp += 1;
-    }
-    child[(sorted[0] & 15) as usize]
+    push_sorted(
+        &sorted[..mask.count_ones() as usize],
+        15,
+        child,
+        entry,
+        stack,
+        sp,
+    )
 }
 
 #[cfg(test)]
