@@ -2,7 +2,7 @@
 //! scene where spatial splits must pay off, the reference budget, and thread independence.
 
 use raybench_accel::{Accel, BuildStats, Counters};
-use raybench_bvh::{Bvh, Bvh8, BvhParams, SpatialSplits, WideParams};
+use raybench_bvh::{Bvh, Bvh8, Bvh16, BvhParams, PacketFloors, SpatialSplits, WideParams};
 use raybench_testkit::{Case, check_case, conformance};
 use std::sync::Arc;
 
@@ -72,6 +72,31 @@ fn packet_walk_over_split_references_conforms() {
             let rays = raybench_testkit::valid_rays(&case);
             raybench_testkit::packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
         }
+    }
+}
+
+/// The same over 16-wide nodes with the registry's floors (`bvh16-sbvh-packets`): the packet
+/// bounds rule children out eight slots a pass, two passes a node, and the windows sent ray by
+/// ray take the 16-wide walk.
+#[test]
+fn sixteen_wide_packet_walk_over_split_references_conforms() {
+    let params = WideParams {
+        width: 16,
+        coherent_packets: true,
+        packet_floors: PacketFloors::MEASURED,
+        ..WideParams::sbvh()
+    };
+    let counts = conformance::<Bvh16>(&params, &|b, m| b.validate(m));
+    assert_eq!(counts.mismatch, 0, "{params:?}");
+    assert!(counts.exact > 10_000, "{counts:?}");
+    for case in raybench_testkit::seeded_cases()
+        .into_iter()
+        .chain(raybench_testkit::edge_cases())
+    {
+        let bvh = Bvh16::build(case.mesh.clone(), &params).expect("builds");
+        assert_eq!(bvh.name(), "bvh16-sbvh-packets");
+        let rays = raybench_testkit::valid_rays(&case);
+        raybench_testkit::packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
     }
 }
 

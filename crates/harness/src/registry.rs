@@ -253,6 +253,17 @@ fn own_structures() -> Vec<StructureEntry> {
                 ..WideParams::sbvh()
             },
         ),
+        register::<Bvh16>(
+            "bvh16-sbvh-packets",
+            "bvh16-sbvh's tree traced as bvh8-packets traces: coherent batches (primary rays for closest hit, shadow rays for any hit) sixteen consecutive rays a packet over 16-wide nodes, every other batch ray by ray as bvh16-sbvh",
+            None,
+            |_| WideParams {
+                width: 16,
+                coherent_packets: true,
+                packet_floors: PacketFloors::MEASURED,
+                ..WideParams::sbvh()
+            },
+        ),
         register::<Bvh8Compressed>(
             "bvh8-compressed",
             "the bvh8-binned tree (same collapse, same Tri4 leaves, same walk) with quantized nodes: per node and axis an f32 origin and a power-of-two step, each child plane one byte rounded outward, 128 bytes a node instead of 256; each plane row decoded in AVX2 registers before the same 8-lane box test",

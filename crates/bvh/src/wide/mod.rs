@@ -220,9 +220,9 @@ impl<const W: usize> Accel for BvhWide<W> {
         })
     }
 
-    /// The registered names. A 4-wide tree with `coherent_packets` is registered nowhere; the
-    /// packet walk runs on it all the same (the conformance tests check it), under its tree's
-    /// name.
+    /// The registered names. A 4-wide tree or a 16-wide binned tree with `coherent_packets` is
+    /// registered nowhere; the packet walk runs on it all the same (the conformance tests check
+    /// it), under its tree's name.
     fn name(&self) -> &str {
         match (W, self.params.coherent_packets) {
             (8, false)
@@ -234,6 +234,7 @@ impl<const W: usize> Accel for BvhWide<W> {
             (8, false) if self.params.binary.spatial_splits.is_some() => "bvh8-sbvh",
             (8, true) if self.params.binary.spatial_splits.is_some() => "bvh8-sbvh-packets",
             (4, _) => "bvh4-binned",
+            (16, true) if self.params.binary.spatial_splits.is_some() => "bvh16-sbvh-packets",
             (16, _) if self.params.binary.spatial_splits.is_some() => "bvh16-sbvh",
             (16, _) => "bvh16-binned",
             (_, false) if self.params.binary.reinsertion.is_some() => "bvh8-reinsert",
