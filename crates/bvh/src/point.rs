@@ -64,7 +64,11 @@ fn binary_child_distances(p: &SplatPoint, n: &Node) -> [f32; 2] {
 /// the nearer subtrees last); the farther ones popped on the way are dropped for good, since
 /// the bound only shrinks.
 #[inline(always)]
-fn pop_within(stack: &[(ChildRef, f32)], sp: &mut usize, bound: f32) -> Option<ChildRef> {
+pub(crate) fn pop_within(
+    stack: &[(ChildRef, f32)],
+    sp: &mut usize,
+    bound: f32,
+) -> Option<ChildRef> {
     while *sp > 0 {
         *sp -= 1;
         let (r, d2) = stack[*sp];

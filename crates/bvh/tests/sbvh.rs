@@ -2,7 +2,7 @@
 //! scene where spatial splits must pay off, the reference budget, and thread independence.
 
 use raybench_accel::{Accel, BuildStats, Counters};
-use raybench_bvh::{Bvh, Bvh8, Bvh16, BvhParams, PacketFloors, SpatialSplits, WideParams};
+use raybench_bvh::{Bvh, Bvh8, BvhParams, BvhWide, PacketFloors, SpatialSplits, WideParams};
 use raybench_testkit::{Case, check_case, conformance};
 use std::sync::Arc;
 
@@ -49,10 +49,26 @@ fn wide_sbvh_conforms() {
     }
 }
 
-/// The packet walk (`bvh8-sbvh-packets`) over a tree whose leaves share triangles: the shared
-/// suite (whose coherent-batch check holds it to brute force), and on every case's rays the
-/// single-ray walk's answers but for ties. A triangle in two leaves a packet reaches is tested
-/// twice with the same answer, so duplicates change nothing a lane sees.
+/// The packet walk over `params`' tree, whose leaves share triangles, registered as `name`:
+/// the shared suite (whose coherent-batch check holds it to brute force), and on every case's
+/// rays the single-ray walk's answers but for ties. A triangle in two leaves a packet reaches is
+/// tested twice with the same answer, so duplicates change nothing a lane sees.
+fn packets_over_split_references_conform<const W: usize>(params: WideParams, name: &str) {
+    let counts = conformance::<BvhWide<W>>(&params, &|b, m| b.validate(m));
+    assert_eq!(counts.mismatch, 0, "{params:?}");
+    assert!(counts.exact > 10_000, "{counts:?}");
+    for case in raybench_testkit::seeded_cases()
+        .into_iter()
+        .chain(raybench_testkit::edge_cases())
+    {
+        let bvh = BvhWide::<W>::build(case.mesh.clone(), &params).expect("builds");
+        assert_eq!(bvh.name(), name);
+        let rays = raybench_testkit::valid_rays(&case);
+        raybench_testkit::packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
+    }
+}
+
+/// `bvh8-sbvh-packets`' walk, at two reference budgets.
 #[test]
 fn packet_walk_over_split_references_conforms() {
     for params in [WideParams::sbvh(), sbvh(2.0)] {
@@ -60,18 +76,7 @@ fn packet_walk_over_split_references_conforms() {
             coherent_packets: true,
             ..params
         };
-        let counts = conformance::<Bvh8>(&params, &|b, m| b.validate(m));
-        assert_eq!(counts.mismatch, 0, "{params:?}");
-        assert!(counts.exact > 10_000, "{counts:?}");
-        for case in raybench_testkit::seeded_cases()
-            .into_iter()
-            .chain(raybench_testkit::edge_cases())
-        {
-            let bvh = Bvh8::build(case.mesh.clone(), &params).expect("builds");
-            assert_eq!(bvh.name(), "bvh8-sbvh-packets");
-            let rays = raybench_testkit::valid_rays(&case);
-            raybench_testkit::packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
-        }
+        packets_over_split_references_conform::<8>(params, "bvh8-sbvh-packets");
     }
 }
 
@@ -86,18 +91,7 @@ fn sixteen_wide_packet_walk_over_split_references_conforms() {
         packet_floors: PacketFloors::MEASURED,
         ..WideParams::sbvh()
     };
-    let counts = conformance::<Bvh16>(&params, &|b, m| b.validate(m));
-    assert_eq!(counts.mismatch, 0, "{params:?}");
-    assert!(counts.exact > 10_000, "{counts:?}");
-    for case in raybench_testkit::seeded_cases()
-        .into_iter()
-        .chain(raybench_testkit::edge_cases())
-    {
-        let bvh = Bvh16::build(case.mesh.clone(), &params).expect("builds");
-        assert_eq!(bvh.name(), "bvh16-sbvh-packets");
-        let rays = raybench_testkit::valid_rays(&case);
-        raybench_testkit::packets_against_single_rays(&bvh, &case.mesh, &rays, &case.name);
-    }
+    packets_over_split_references_conform::<16>(params, "bvh16-sbvh-packets");
 }
 
 #[test]

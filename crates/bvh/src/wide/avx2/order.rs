@@ -71,7 +71,6 @@ pub(super) fn nearest_first_sorted<const W: usize>(
     unsafe { _mm256_storeu_si256(sorted.as_mut_ptr().cast(), sort8(keys)) };
     push_sorted(
         &sorted[..mask.count_ones() as usize],
-        7,
         child,
         entry,
         stack,
@@ -80,17 +79,17 @@ pub(super) fn nearest_first_sorted<const W: usize>(
 }
 
 /// The children of the sorted keys `sorted` (the entered ones, nearest first; the slot in the
-/// bits of `slot_bits`): pushes all but the first so that they pop nearest first, and returns
-/// the first.
+/// low bits, below `W`, a power of two): pushes all but the first so that they pop nearest
+/// first, and returns the first.
 #[inline(always)]
 fn push_sorted<const W: usize>(
     sorted: &[u32],
-    slot_bits: u32,
     child: &[ChildRef; W],
     entry: &[f32; W],
     stack: &mut Stack,
     sp: &mut usize,
 ) -> ChildRef {
+    let slot_bits = (W - 1) as u32;
     for &key in sorted[1..].iter().rev() {
         let slot = (key & slot_bits) as usize;
         stack[*sp] = (child[slot], entry[slot]);
@@ -154,7 +153,6 @@ pub(super) fn nearest_first_sorted16<const W: usize>(
     unsafe { _mm512_storeu_si512(sorted.as_mut_ptr().cast(), sort16(keys)) };
     push_sorted(
         &sorted[..mask.count_ones() as usize],
-        15,
         child,
         entry,
         stack,

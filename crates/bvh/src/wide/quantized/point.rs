@@ -6,7 +6,9 @@
 
 use super::BvhQuantized;
 use super::node::{Plane, QWIDTH};
-use crate::node::{ChildRef, MAX_DEPTH};
+use crate::node::ChildRef;
+use crate::point::pop_within;
+use crate::wide::with_stack;
 use raybench_accel::{CounterSink, Nearest, PointHit};
 use raybench_geom::{Vec3, box_distance_squared};
 
@@ -22,60 +24,55 @@ impl<P: Plane> BvhQuantized<P> {
         {
             return None;
         }
-        // A node pushes at most `QWIDTH - 1` children, one node a level.
-        let mut stack = [(ChildRef::default(), 0f32); (QWIDTH - 1) * MAX_DEPTH + 1];
-        let mut sp = 0;
-        let mut next = Some(self.root);
-        loop {
-            while let Some(r) = next.take() {
-                if r.is_leaf() {
-                    c.leaf();
-                    let first = 4 * r.index as usize;
-                    for slot in first..first + r.count as usize {
-                        c.prim_tests(1);
-                        let prim = self.tri4s[slot / 4].ids[slot % 4];
-                        nearest.test_triangle(p, prim, &self.mesh.triangle(prim as usize));
+        // The ray walk's per-thread stack (as deep as any walk needs), not one cleared per query.
+        with_stack(|stack| {
+            let mut sp = 0;
+            let mut next = Some(self.root);
+            loop {
+                while let Some(r) = next.take() {
+                    if r.is_leaf() {
+                        c.leaf();
+                        let first = 4 * r.index as usize;
+                        for slot in first..first + r.count as usize {
+                            c.prim_tests(1);
+                            let prim = self.tri4s[slot / 4].ids[slot % 4];
+                            nearest.test_triangle(p, prim, &self.mesh.triangle(prim as usize));
+                        }
+                        break;
                     }
-                    break;
-                }
-                c.node();
-                let n = &self.nodes[r.index as usize];
-                // The children within the bound, nearest first (insertion sort of at most 8).
-                let mut kids = [(ChildRef::default(), 0f32); QWIDTH];
-                let mut len = 0;
-                for i in 0..n.children() {
-                    let d = box_distance_squared(p, &n.child_bounds(i));
-                    if d > nearest.bound_d2() {
-                        continue;
+                    c.node();
+                    let n = &self.nodes[r.index as usize];
+                    // The children within the bound, nearest first (insertion sort of at most 8).
+                    let mut kids = [(ChildRef::default(), 0f32); QWIDTH];
+                    let mut len = 0;
+                    for i in 0..n.children() {
+                        let d = box_distance_squared(p, &n.child_bounds(i));
+                        if d > nearest.bound_d2() {
+                            continue;
+                        }
+                        let mut at = len;
+                        while at > 0 && kids[at - 1].1 > d {
+                            kids[at] = kids[at - 1];
+                            at -= 1;
+                        }
+                        kids[at] = (n.child[i], d);
+                        len += 1;
                     }
-                    let mut at = len;
-                    while at > 0 && kids[at - 1].1 > d {
-                        kids[at] = kids[at - 1];
-                        at -= 1;
+                    if len == 0 {
+                        break;
                     }
-                    kids[at] = (n.child[i], d);
-                    len += 1;
+                    // Farthest pushed first, so the nearest pushed one is popped first.
+                    for &entry in kids[1..len].iter().rev() {
+                        stack[sp] = entry;
+                        sp += 1;
+                    }
+                    next = Some(kids[0].0);
                 }
-                if len == 0 {
-                    break;
-                }
-                // Farthest pushed first, so the nearest pushed one is popped first.
-                for &entry in kids[1..len].iter().rev() {
-                    stack[sp] = entry;
-                    sp += 1;
-                }
-                next = Some(kids[0].0);
-            }
-            // The nearest pushed subtree that may still hold a nearer triangle.
-            while sp > 0 && next.is_none() {
-                sp -= 1;
-                if stack[sp].1 <= nearest.bound_d2() {
-                    next = Some(stack[sp].0);
+                next = pop_within(stack.as_slice(), &mut sp, nearest.bound_d2());
+                if next.is_none() {
+                    return nearest.into_hit();
                 }
             }
-            if next.is_none() {
-                return nearest.into_hit();
-            }
-        }
+        })
     }
 }
