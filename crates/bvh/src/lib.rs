@@ -82,6 +82,12 @@ pub struct BvhParams {
     pub reinsertion: Option<Reinsertion>,
     /// Spatial splits (a Split BVH, see `build/spatial`): `None` builds object splits only.
     pub spatial_splits: Option<SpatialSplits>,
+    /// Children of at least this many triangles take their centroid bounds from their boxes
+    /// (known from the bins: twice the box, clipped to the parent's centroid bounds) instead of
+    /// a pass over their records. Such bounds hold every centroid but are looser where the
+    /// triangles are large beside the node, which costs little in large nodes; `None`: a pass
+    /// for every child.
+    pub centroids_from_boxes: Option<u32>,
 }
 
 impl Default for BvhParams {
@@ -108,6 +114,7 @@ impl BvhParams {
             memory_limit_bytes: BvhParams::MEMORY_LIMIT,
             reinsertion: None,
             spatial_splits: None,
+            centroids_from_boxes: None,
         }
     }
     pub fn median() -> BvhParams {

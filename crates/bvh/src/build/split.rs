@@ -419,21 +419,38 @@ pub(crate) fn binned_split(
         1 => partition(refs, mid, |p| goes_left(p.centroid2_on(1))),
         _ => partition(refs, mid, |p| goes_left(p.centroid2_on(2))),
     }
-    // Each side's box is the union of its bins' boxes: only the centroid bounds need a pass.
+    // Each side's box is the union of its bins' boxes; the centroid bounds take a pass, or
+    // are bounded by the box (`centroids_from_boxes`).
     let side = |bins_range: std::ops::Range<usize>| {
         bins.boxes[bins_range]
             .iter()
             .fold(Box3::EMPTY, |acc, b| acc.union(&b[axis]))
     };
+    let (left, right) = (side(0..boundary), side(boundary..nb));
+    let centroids = |bounds: Box3, refs: &[PrimRef]| {
+        if p.centroids_from_boxes
+            .is_some_and(|m| refs.len() >= m as usize)
+        {
+            // A centroid (doubled: `lo + hi`) lies in twice its side's box, and rounding keeps
+            // it there (`x + y <= 2 * max` holds in floating point as in exact arithmetic), so
+            // the binner's mapping never leaves its bins.
+            Box3 {
+                lo: (bounds.lo * 2.0).max(r.centroids.lo),
+                hi: (bounds.hi * 2.0).min(r.centroids.hi),
+            }
+        } else {
+            Box3::centroids_of(refs, PARALLEL_BINNING)
+        }
+    };
     Some(Split {
         mid,
         left: Ranged {
-            bounds: side(0..boundary),
-            centroids: Box3::centroids_of(&refs[..mid], PARALLEL_BINNING),
+            bounds: left,
+            centroids: centroids(left, &refs[..mid]),
         },
         right: Ranged {
-            bounds: side(boundary..nb),
-            centroids: Box3::centroids_of(&refs[mid..], PARALLEL_BINNING),
+            bounds: right,
+            centroids: centroids(right, &refs[mid..]),
         },
     })
 }
@@ -494,84 +511,4 @@ fn partition(refs: &mut [PrimRef], mid: usize, goes_left: impl Fn(&PrimRef) -> b
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::WideParams;
-    use raybench_geom::Aabb;
-
-    /// Boxes of `n` small triangles scattered in the unit cube, from a fixed seed.
-    fn scattered(n: usize, seed: u64) -> Vec<Aabb> {
-        let mut rng = raybench_geom::SplitMix64::new(seed);
-        (0..n)
-            .map(|_| {
-                let lo = rng.unit_vec();
-                Aabb::new(lo, lo + rng.unit_vec() * 0.05)
-            })
-            .collect()
-    }
-
-    fn refs_of(boxes: &[Aabb], scale: f32) -> Vec<PrimRef> {
-        let scaled = |b: &Aabb| Aabb::new(b.min * scale, b.max * scale);
-        (0..boxes.len())
-            .map(|i| PrimRef::new(&scaled(&boxes[i]), i as u32))
-            .collect()
-    }
-
-    /// The premise of [`leaf_beats_any_split`], which lets the builder skip binning: with the
-    /// wide tree's knobs no split of up to four triangles is ever taken, by the binned or the
-    /// sweep builder, and five may be.
-    #[test]
-    fn a_leaf_no_dearer_than_a_node_step_is_never_split() {
-        let wide = WideParams::default().binary;
-        assert!(leaf_beats_any_split(&wide, 4));
-        assert!(!leaf_beats_any_split(&wide, 5));
-        assert!(!leaf_beats_any_split(&BvhParams::binned(), 2));
-        for seed in 0..200 {
-            for n in 2..=4 {
-                let mut refs = refs_of(&scattered(n, seed), 1.0);
-                let r = Ranged::of(&refs, PARALLEL_BINNING);
-                let binned = binned_split(&mut refs, &r, &wide, &mut Scratch::new());
-                assert!(binned.is_none(), "seed {seed}: {n} triangles split");
-                assert!(sweep_split(&mut refs, &r, &wide).is_none());
-            }
-        }
-    }
-
-    /// The sweep runs in f32 on coordinates scaled by the node's largest extent, so the split
-    /// does not depend on the mesh's scale (powers of two scale exactly), from 2^-60 to near
-    /// the mesh limit of 1.8e18, where unscaled areas weighted by counts would overflow f32.
-    #[test]
-    fn the_binned_split_is_the_same_at_every_scale() {
-        for (seed, n) in [(1, 40), (2, 300), (3, 5000)] {
-            let boxes = scattered(n, seed);
-            let split_at = |scale: f32| {
-                let mut refs = refs_of(&boxes, scale);
-                let r = Ranged::of(&refs, PARALLEL_BINNING);
-                let p = WideParams::default().binary;
-                let s = binned_split(&mut refs, &r, &p, &mut Scratch::new()).expect("splits");
-                let left: Vec<u32> = refs[..s.mid].iter().map(PrimRef::id).collect();
-                (s.mid, left)
-            };
-            let unit = split_at(1.0);
-            assert!(0 < unit.0 && unit.0 < n);
-            for scale in [2f32.powi(-60), 2f32.powi(59)] {
-                assert_eq!(split_at(scale), unit, "seed {seed}, scale {scale:e}");
-            }
-        }
-    }
-
-    #[test]
-    fn a_node_gets_a_bin_per_triangles_per_bin() {
-        let p = BvhParams {
-            bins: 64,
-            triangles_per_bin: 4,
-            ..BvhParams::binned()
-        };
-        let bins: Vec<usize> = [2, 9, 40, 255, 256, 100_000]
-            .iter()
-            .map(|&n| bins_for(&p, n))
-            .collect();
-        assert_eq!(bins, [2, 2, 10, 63, 64, 64]);
-        assert_eq!(bins_for(&BvhParams::binned(), 20), 20);
-    }
-}
+mod tests;

@@ -118,6 +118,10 @@ impl WideParams {
     pub fn sbvh() -> WideParams {
         let mut p = WideParams::for_width(8);
         p.binary.spatial_splits = Some(crate::SpatialSplits::default());
+        // The Split BVH keeps the exact bounds: with the box's bounds its SAH cost rose on
+        // some scenes (the tilted plane of the held-out suite by 6 %; docs/experiments.md,
+        // "centroid bounds from the children's boxes").
+        p.binary.centroids_from_boxes = None;
         p
     }
 }
@@ -138,6 +142,10 @@ impl Default for WideParams {
                 // Two `Tri4`s, one AVX2 leaf pass: measured, see docs/experiments.md, "leaves of
                 // at most 8 triangles instead of 16 (with slots filled)".
                 max_leaf_size: 8,
+                // One pass fewer per node of 256 triangles or more, for the same trees within
+                // a few tenths of a per cent of SAH cost: measured, see docs/experiments.md,
+                // "centroid bounds from the children's boxes".
+                centroids_from_boxes: Some(256),
                 ..BvhParams::binned()
             },
             width: 8,
