@@ -142,8 +142,8 @@ impl Default for WideParams {
                 // Two `Tri4`s, one AVX2 leaf pass: measured, see docs/experiments.md, "leaves of
                 // at most 8 triangles instead of 16 (with slots filled)".
                 max_leaf_size: 8,
-                // One pass fewer per node of 256 triangles or more, for the same trees within
-                // a few tenths of a per cent of SAH cost: measured, see docs/experiments.md,
+                // One pass fewer per node of 256 triangles or more, for trees whose SAH cost
+                // moves by a few tenths of a per cent: measured, see docs/experiments.md,
                 // "centroid bounds from the children's boxes".
                 centroids_from_boxes: Some(256),
                 ..BvhParams::binned()
