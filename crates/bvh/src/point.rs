@@ -155,29 +155,45 @@ fn wide_child_distances<const W: usize>(p: &SplatPoint, n: &WideNode<W>) -> [f32
     d
 }
 
-/// The children of a wide node within `bound`, sorted nearest first (insertion sort on at most
-/// eight entries, in registers). Returns how many there are.
+/// The children within `bound` (`child[i]` at squared distance `d[i]`), sorted nearest first
+/// into `out` (insertion sort on at most sixteen entries, in registers). Returns how many there
+/// are. Shared by the float and quantized wide trees.
 #[inline(always)]
-fn children_within<const W: usize>(
-    n: &WideNode<W>,
-    d: &[f32; W],
+pub(crate) fn children_within(
+    child: &[ChildRef],
+    d: &[f32],
     bound: f32,
-    out: &mut [(ChildRef, f32); W],
+    out: &mut [(ChildRef, f32)],
 ) -> usize {
     let mut len = 0;
-    for (i, &di) in d.iter().enumerate() {
+    for (&c, &di) in child.iter().zip(d) {
         if di > bound {
-            continue; // also every unused slot: its distance is +inf
+            continue; // also every unused slot of a float node: its distance is +inf
         }
         let mut at = len;
         while at > 0 && out[at - 1].1 > di {
             out[at] = out[at - 1];
             at -= 1;
         }
-        out[at] = (n.child[i], di);
+        out[at] = (c, di);
         len += 1;
     }
     len
+}
+
+/// Descends into the nearest of `kids` (sorted nearest first, at least one) and pushes the
+/// rest, farthest first, so the nearest pushed one is popped first.
+#[inline(always)]
+pub(crate) fn descend(
+    kids: &[(ChildRef, f32)],
+    stack: &mut [(ChildRef, f32)],
+    sp: &mut usize,
+) -> ChildRef {
+    for &entry in kids[1..].iter().rev() {
+        stack[*sp] = entry;
+        *sp += 1;
+    }
+    kids[0].0
 }
 
 /// The closest-point walk of a wide BVH, counting into `c` (a no-op for `NoCount`).
@@ -207,16 +223,11 @@ pub(crate) fn closest_point_wide<const W: usize, C: CounterSink>(
                 c.node();
                 let n = &bvh.nodes[r.index as usize];
                 let d = wide_child_distances(&splat, n);
-                let len = children_within(n, &d, nearest.bound_d2(), &mut kids);
+                let len = children_within(&n.child, &d, nearest.bound_d2(), &mut kids);
                 if len == 0 {
                     break;
                 }
-                // Farthest pushed first, so the nearest pushed one is popped first.
-                for &entry in kids[1..len].iter().rev() {
-                    stack[sp] = entry;
-                    sp += 1;
-                }
-                next = Some(kids[0].0);
+                next = Some(descend(&kids[..len], stack.as_mut_slice(), &mut sp));
             }
             next = pop_within(stack.as_slice(), &mut sp, nearest.bound_d2());
             if next.is_none() {
@@ -276,7 +287,7 @@ mod tests {
         }
         let d = [5.0, 1.0, f32::INFINITY, 3.0, 0.0, 9.0, 3.0, 2.0];
         let mut out = [(ChildRef::default(), 0f32); 8];
-        let len = children_within(&n, &d, 5.0, &mut out);
+        let len = children_within(&n.child, &d, 5.0, &mut out);
         let order: Vec<u32> = out[..len].iter().map(|(c, _)| c.index).collect();
         assert_eq!(
             order,

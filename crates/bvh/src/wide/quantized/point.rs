@@ -7,7 +7,7 @@
 use super::BvhQuantized;
 use super::node::{Plane, QWIDTH};
 use crate::node::ChildRef;
-use crate::point::pop_within;
+use crate::point::{children_within, descend, pop_within};
 use crate::wide::with_stack;
 use raybench_accel::{CounterSink, Nearest, PointHit};
 use raybench_geom::{Vec3, box_distance_squared};
@@ -42,31 +42,18 @@ impl<P: Plane> BvhQuantized<P> {
                     }
                     c.node();
                     let n = &self.nodes[r.index as usize];
-                    // The children within the bound, nearest first (insertion sort of at most 8).
-                    let mut kids = [(ChildRef::default(), 0f32); QWIDTH];
-                    let mut len = 0;
-                    for i in 0..n.children() {
-                        let d = box_distance_squared(p, &n.child_bounds(i));
-                        if d > nearest.bound_d2() {
-                            continue;
-                        }
-                        let mut at = len;
-                        while at > 0 && kids[at - 1].1 > d {
-                            kids[at] = kids[at - 1];
-                            at -= 1;
-                        }
-                        kids[at] = (n.child[i], d);
-                        len += 1;
+                    let k = n.children();
+                    let mut d = [0f32; QWIDTH];
+                    for (i, di) in d[..k].iter_mut().enumerate() {
+                        *di = box_distance_squared(p, &n.child_bounds(i));
                     }
+                    let mut kids = [(ChildRef::default(), 0f32); QWIDTH];
+                    let len =
+                        children_within(&n.child[..k], &d[..k], nearest.bound_d2(), &mut kids);
                     if len == 0 {
                         break;
                     }
-                    // Farthest pushed first, so the nearest pushed one is popped first.
-                    for &entry in kids[1..len].iter().rev() {
-                        stack[sp] = entry;
-                        sp += 1;
-                    }
-                    next = Some(kids[0].0);
+                    next = Some(descend(&kids[..len], stack.as_mut_slice(), &mut sp));
                 }
                 next = pop_within(stack.as_slice(), &mut sp, nearest.bound_d2());
                 if next.is_none() {
