@@ -11,9 +11,10 @@
 //! of the rays), since a test costs the same for one lane as for sixteen. This is the classic
 //! packet traversal of Wald, Slusallek, Benthin and Wagner (2001), on a BVH as in Wald, Boulos and
 //! Shirley (2007, "Ray tracing deformable scenes using dynamic bounding volume hierarchies").
-//! As there, bounds over the whole packet (`frustum.rs`) first rule out, in one 8-lane pass, the
-//! children no ray can enter, so only the others are tested ray by ray: 5–20 % faster on camera
-//! rays (measured: see docs/experiments.md, "packet bounds before the per-ray box tests"). The
+//! As there, bounds over the whole packet (`frustum.rs`) first rule out, in one pass over the
+//! node's planes, the children no ray can enter, so only the others are tested ray by ray: 5–20 %
+//! faster on camera rays (measured: see docs/experiments.md, "packet bounds before the per-ray box
+//! tests"). The
 //! trade-off, measured over the default suite's primary rays (docs/results/): 1.5–2.8× the
 //! single-ray walk on scenes of large triangles (Sponza, the teapots, Sibenik), little or less
 //! where triangles are smaller than the rays' spacing (the stadium from afar, San Francisco).
