@@ -27,25 +27,29 @@ raybench_accel::per_thread_stack!(
 );
 
 /// Any hit will do, so no sorting (as Embree's occlusion traversal): returns the child in the
-/// lowest slot of `mask` and pushes the others to pop in slot order. Their entry distances are
-/// not kept: an any-hit walk ends at its first hit, so `t_max` never shrinks and no pushed
-/// subtree is ever skipped (the pop does not look at them either).
+/// lowest slot of `mask` and pushes the others to pop in slot order, calling `fetch` on each
+/// (the returned child first) in the same pass over the mask, so a node pays for one loop's exit,
+/// not two. Their entry distances are not kept: an any-hit walk ends at its first hit, so `t_max`
+/// never shrinks and no pushed subtree is ever skipped (the pop does not look at them either).
 #[inline(always)]
 pub(super) fn first_in_slot_order<const W: usize>(
     child: &[ChildRef; W],
     mask: u32,
     stack: &mut Stack,
     sp: &mut usize,
+    fetch: impl Fn(ChildRef),
 ) -> ChildRef {
-    let first = mask.trailing_zeros() as usize;
+    let first = child[mask.trailing_zeros() as usize];
+    fetch(first);
     let mut rest = mask & (mask - 1);
     while rest != 0 {
         let i = 31 - rest.leading_zeros() as usize;
         rest &= !(1 << i);
+        fetch(child[i]);
         stack[*sp] = (child[i], 0.0);
         *sp += 1;
     }
-    child[first]
+    first
 }
 
 /// Of the children `child` in `mask` (entry distances `entry`), returns the nearest and pushes
@@ -150,10 +154,10 @@ impl<const W: usize> BvhWide<W> {
                 let n = &self.nodes[r.index as usize];
                 let (mask, entry) = kernel.test(&wide, n, t_min, best_t);
                 if mask != 0 {
-                    self.prefetch_children(n, mask);
                     r = if ANY_HIT {
-                        first_in_slot_order(&n.child, mask, stack, &mut sp)
+                        first_in_slot_order(&n.child, mask, stack, &mut sp, |c| self.prefetch(c))
                     } else {
+                        self.prefetch_children(n, mask);
                         kernel.order(&n.child, mask, &entry, stack, &mut sp)
                     };
                     continue 'walk;
@@ -175,18 +179,22 @@ impl<const W: usize> BvhWide<W> {
         best.map(|(lane, h)| Hit::from_tri_hit(self.tri4s[lane / 4].ids[lane % 4], h))
     }
 
-    /// Starts fetching every child in `mask`: a node's four (8 wide) or two (4 wide) lines, or
-    /// a leaf's first `Tri4` (three lines).
+    /// Starts fetching every child in `mask` (see [`BvhWide::prefetch`]).
     #[inline(always)]
     fn prefetch_children(&self, n: &WideNode<W>, mut mask: u32) {
         while mask != 0 {
-            let r = n.child[mask.trailing_zeros() as usize];
+            self.prefetch(n.child[mask.trailing_zeros() as usize]);
             mask &= mask - 1;
-            if r.is_leaf() {
-                prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
-            } else {
-                prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
-            }
+        }
+    }
+
+    /// Starts fetching `r`: a node's first line, or a leaf's first `Tri4`.
+    #[inline(always)]
+    fn prefetch(&self, r: ChildRef) {
+        if r.is_leaf() {
+            prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
+        } else {
+            prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
         }
     }
 

@@ -91,26 +91,31 @@ impl<P: Plane> BvhQuantized<P> {
         stack: &mut Stack,
         sp: &mut usize,
     ) -> ChildRef {
-        self.prefetch_children(child, mask);
         if ANY_HIT {
-            first_in_slot_order(child, mask, stack, sp)
+            first_in_slot_order(child, mask, stack, sp, |r| self.prefetch(r))
         } else {
+            self.prefetch_children(child, mask);
             nearest_first(child, mask, entry, stack, sp)
         }
     }
 
-    /// Starts fetching every child in `mask`: all of a node's lines (two or three), or a
-    /// leaf's first `Tri4` (three lines).
+    /// Starts fetching every child in `mask` (see [`BvhQuantized::prefetch`]).
     #[inline(always)]
     fn prefetch_children(&self, child: &[ChildRef; QWIDTH], mut mask: u32) {
         while mask != 0 {
-            let r = child[mask.trailing_zeros() as usize];
+            self.prefetch(child[mask.trailing_zeros() as usize]);
             mask &= mask - 1;
-            if r.is_leaf() {
-                prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
-            } else {
-                prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
-            }
+        }
+    }
+
+    /// Starts fetching `r`: all of a node's lines (two or three), or a leaf's first `Tri4`
+    /// (three lines).
+    #[inline(always)]
+    fn prefetch(&self, r: ChildRef) {
+        if r.is_leaf() {
+            prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
+        } else {
+            prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
         }
     }
 
