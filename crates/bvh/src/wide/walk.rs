@@ -311,4 +311,46 @@ mod tests {
         let checked = check_against_insertion::<8>(masks, nearest_first);
         assert_eq!(checked, (8 + 28 + 56) * 25);
     }
+
+    /// The any-hit walk fetches every entered child exactly once, and no other, the child it
+    /// walks next first: every mask of 8 children and every 5th of 16.
+    #[test]
+    fn every_entered_child_is_fetched_once() {
+        fn check<const W: usize>(masks: impl Iterator<Item = u32>) {
+            let child: [ChildRef; W] = std::array::from_fn(|i| ChildRef {
+                index: i as u32,
+                count: 0,
+            });
+            let mut stack = new_stack();
+            for mask in masks {
+                let fetched = std::cell::Cell::new(0u32);
+                let fetch = |c: ChildRef| {
+                    let bit = 1 << c.index;
+                    assert_eq!(
+                        fetched.get() & bit,
+                        0,
+                        "mask {mask:b}: slot {} twice",
+                        c.index
+                    );
+                    if fetched.get() == 0 {
+                        assert_eq!(bit, mask & mask.wrapping_neg(), "mask {mask:b}: first");
+                    }
+                    fetched.set(fetched.get() | bit);
+                };
+                let mut sp = 0;
+                let first = first_in_slot_order(&child, mask, &mut stack, &mut sp, fetch);
+                assert_eq!(fetched.get(), mask, "mask {mask:b}");
+                assert_eq!(first.index, mask.trailing_zeros());
+                // The rest pop in slot order.
+                let popped: Vec<u32> = stack[..sp].iter().rev().map(|e| e.0.index).collect();
+                let rest: Vec<u32> = (0..W as u32)
+                    .filter(|&i| mask >> i & 1 == 1)
+                    .skip(1)
+                    .collect();
+                assert_eq!(popped, rest, "mask {mask:b}");
+            }
+        }
+        check::<8>(1u32..256);
+        check::<16>((1u32..1 << 16).step_by(5));
+    }
 }
