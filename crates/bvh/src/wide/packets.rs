@@ -14,10 +14,10 @@
 //! As there, bounds over the whole packet (`frustum.rs`) first rule out, in one pass over the
 //! node's planes, the children no ray can enter, so only the others are tested ray by ray: 5–20 %
 //! faster on camera rays (measured: see docs/experiments.md, "packet bounds before the per-ray box
-//! tests"). The
-//! trade-off, measured over the default suite's primary rays (docs/results/): 1.5–2.8× the
-//! single-ray walk on scenes of large triangles (Sponza, the teapots, Sibenik), little or less
-//! where triangles are smaller than the rays' spacing (the stadium from afar, San Francisco).
+//! tests"). The trade-off, measured over the default suite's primary rays (docs/results/):
+//! 1.5–2.8× the single-ray walk on scenes of large triangles (Sponza, the teapots, Sibenik),
+//! little or less where triangles are smaller than the rays' spacing (the stadium from afar, San
+//! Francisco).
 //! Handing sparse subtrees or leaves back to the single-ray walk, as Embree's hybrid traversal
 //! does, did not measurably help (docs/experiments.md, "Packets for coherent rays"); handing
 //! whole packets over does, where the rays share little ([`Switch`], the `packet_floors` knob):
