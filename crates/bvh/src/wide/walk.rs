@@ -52,6 +52,18 @@ pub(super) fn first_in_slot_order<const W: usize>(
     first
 }
 
+/// Starts fetching child `r` of a wide tree with `nodes` and `tri4s`: all of a node's lines,
+/// or a leaf's first `Tri4` (three lines). The any-hit walks of the float and quantized trees
+/// fetch with it.
+#[inline(always)]
+pub(super) fn prefetch_child<N>(nodes: &[N], tri4s: &[Tri4], r: ChildRef) {
+    if r.is_leaf() {
+        prefetch(tri4s.as_ptr().wrapping_add(r.index as usize));
+    } else {
+        prefetch(nodes.as_ptr().wrapping_add(r.index as usize));
+    }
+}
+
 /// Of the children `child` in `mask` (entry distances `entry`), returns the nearest and pushes
 /// the others so that they pop nearest first (equal distances: lower slot first). One, two and
 /// three children — most nodes — take a short path; more are inserted into the stack in place.
@@ -155,7 +167,9 @@ impl<const W: usize> BvhWide<W> {
                 let (mask, entry) = kernel.test(&wide, n, t_min, best_t);
                 if mask != 0 {
                     r = if ANY_HIT {
-                        first_in_slot_order(&n.child, mask, stack, &mut sp, |c| self.prefetch(c))
+                        first_in_slot_order(&n.child, mask, stack, &mut sp, |c| {
+                            prefetch_child(&self.nodes, &self.tri4s, c)
+                        })
                     } else {
                         self.prefetch_children(n, mask);
                         kernel.order(&n.child, mask, &entry, stack, &mut sp)
@@ -183,7 +197,7 @@ impl<const W: usize> BvhWide<W> {
     /// chosen without a branch (node or leaf), and a leaf gets as many lines as a node (at 16
     /// wide eight, so both `Tri4`s of a two-`Tri4` leaf), which made 16-wide random rays 7 %
     /// faster and no walk slower (measured: see docs/experiments.md, "closest-hit walks
-    /// prefetching by an address select"). The any-hit walk keeps [`BvhWide::prefetch`], for
+    /// prefetching by an address select"). The any-hit walk keeps [`prefetch_child`], for
     /// which the same change was 2 % slower.
     #[inline(always)]
     fn prefetch_children(&self, n: &WideNode<W>, mut mask: u32) {
@@ -205,16 +219,6 @@ impl<const W: usize> BvhWide<W> {
             for k in 0..lines {
                 prefetch(at.wrapping_add(k));
             }
-        }
-    }
-
-    /// Starts fetching `r`: all of a node's lines, or a leaf's first `Tri4` (three lines).
-    #[inline(always)]
-    fn prefetch(&self, r: ChildRef) {
-        if r.is_leaf() {
-            prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
-        } else {
-            prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
         }
     }
 

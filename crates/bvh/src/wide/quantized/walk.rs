@@ -5,9 +5,8 @@ use super::BvhQuantized;
 use super::kernels::QuantKernel;
 use super::node::{Plane, QWIDTH};
 use crate::node::ChildRef;
-use crate::simd::prefetch;
 use crate::wide::kernels::SseNodes;
-use crate::wide::walk::{Stack, first_in_slot_order, nearest_first, with_stack};
+use crate::wide::walk::{Stack, first_in_slot_order, nearest_first, prefetch_child, with_stack};
 use raybench_accel::{CounterSink, Hit};
 use raybench_geom::{Ray, TriHit};
 
@@ -99,7 +98,8 @@ impl<P: Plane> BvhQuantized<P> {
         }
     }
 
-    /// Starts fetching every child in `mask` (see [`BvhQuantized::prefetch`]).
+    /// Starts fetching every child in `mask` (see [`prefetch_child`]: a node's two or three
+    /// lines).
     #[inline(always)]
     fn prefetch_children(&self, child: &[ChildRef; QWIDTH], mut mask: u32) {
         while mask != 0 {
@@ -108,15 +108,9 @@ impl<P: Plane> BvhQuantized<P> {
         }
     }
 
-    /// Starts fetching `r`: all of a node's lines (two or three), or a leaf's first `Tri4`
-    /// (three lines).
     #[inline(always)]
     fn prefetch(&self, r: ChildRef) {
-        if r.is_leaf() {
-            prefetch(self.tri4s.as_ptr().wrapping_add(r.index as usize));
-        } else {
-            prefetch(self.nodes.as_ptr().wrapping_add(r.index as usize));
-        }
+        prefetch_child(&self.nodes, &self.tri4s, r);
     }
 
     /// [`BvhQuantized::walk_with`] with the kernel chosen at build time.
