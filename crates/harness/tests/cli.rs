@@ -150,14 +150,6 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
     .exists()
     {
         assert!(scenes.contains(&"stanford-bunny.obj"), "{scenes:?}");
-        assert!(
-            report
-                .notes
-                .iter()
-                .any(|n| n.contains("bruteforce skipped on stanford-bunny.obj")),
-            "{:?}",
-            report.notes
-        );
     } else {
         eprintln!(
             "NOT CHECKED: ../shared/scenes is absent, so the suite's bunny was skipped (as a note)"
@@ -168,6 +160,69 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
             report.notes
         );
     }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A suite runs brute force only on scenes within its limit (20,000 triangles), with a note
+/// naming the scene and the limit; naming it with `--structures` runs it everywhere.
+#[test]
+fn a_suite_skips_brute_force_past_its_limit_and_says_so() {
+    let dir = std::env::temp_dir().join(format!("raybench-suite-limit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("limits.json"),
+        r#"{"name": "limits", "description": "brute force past its suite limit",
+            "scenes": ["sphere:triangles=30000", "teapot:triangles=500"],
+            "structures": ["bruteforce", "bvh8-binned"], "workloads": ["primary"], "rays": 200}"#,
+    )
+    .unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        let out_dir = dir.join(out);
+        let status = raybench()
+            .env("RAYBENCH_SUITES", &dir)
+            .args(["run", "--suite", "limits", "--no-images", "--out"])
+            .arg(&out_dir)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            status.status.success(),
+            "{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+        raybench_harness::report::run::Report::read(&out_dir.join("report.json")).unwrap()
+    };
+    let brute_scenes = |r: &raybench_harness::report::run::Report| -> Vec<String> {
+        let mut s: Vec<String> = r
+            .results
+            .iter()
+            .filter(|e| e.structure == "bruteforce")
+            .map(|e| e.scene.clone())
+            .collect();
+        s.sort();
+        s
+    };
+    let limited = run("limited", &[]);
+    assert_eq!(brute_scenes(&limited), ["teapot:triangles=500"]);
+    assert!(
+        limited.notes.iter().any(
+            |n| n.contains("bruteforce skipped on sphere:triangles=30000")
+                && n.contains("suite limit 20000")
+        ),
+        "{:?}",
+        limited.notes
+    );
+    assert_eq!(limited.mismatches(), 0);
+    let named = run("named", &["--structures", "bruteforce,bvh8-binned"]);
+    assert_eq!(
+        brute_scenes(&named),
+        ["sphere:triangles=30000", "teapot:triangles=500"]
+    );
+    assert!(
+        !named.notes.iter().any(|n| n.contains("skipped")),
+        "{:?}",
+        named.notes
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 

@@ -121,7 +121,15 @@ fn small_suites_generate_every_scene_with_its_view() {
         );
         assert_eq!(suite.points, Some(10_000), "{file}");
     }
-    assert_eq!(ci.structures[0], "bruteforce");
+    // Every family against the reference; brute force, the O(N) oracle, is left to the tests
+    // and `verify` (its timing was over half the run's and does not carry between CPUs).
+    for family in ["embree-medium", "bvh8-binned", "kd-sah", "grid", "octree"] {
+        assert!(
+            ci.structures.iter().any(|s| s == family),
+            "ci lacks {family}"
+        );
+    }
+    assert!(!ci.structures.iter().any(|s| s.starts_with("bruteforce")));
 }
 
 #[test]

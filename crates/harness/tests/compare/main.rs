@@ -352,17 +352,61 @@ fn a_schema_1_report_reads_through_the_old_names() {
     );
     let c = compare(&read, base(), &CompareOptions::default());
     assert_eq!(c.regressions(), 0, "{}", text(&c));
-    // The baseline CI compares against loads whatever version it was written with.
-    let baseline = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/baseline/ci.json");
-    Report::read(&baseline).expect("reports/baseline/ci.json reads");
+    // The baselines CI compares against load whatever version they were written with.
+    for baseline in ci_baselines() {
+        Report::read(&baseline).unwrap_or_else(|e| panic!("{}: {e:#}", baseline.display()));
+    }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The committed CI baselines, one per CPU model (`reports/baseline/ci-<cpu>.json`).
+fn ci_baselines() -> Vec<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/baseline");
+    let mut found: Vec<_> = std::fs::read_dir(&dir)
+        .expect("reports/baseline lists")
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_string_lossy();
+            name.starts_with("ci-") && name.ends_with(".json")
+        })
+        .collect();
+    found.sort();
+    assert!(!found.is_empty(), "no reports/baseline/ci-*.json");
+    found
+}
+
+/// Every CI baseline against every other passes with timing advisory: they differ only in the
+/// CPU they were timed on, so their answers and deterministic figures agree (scripts/
+/// update-baseline removes one that stops agreeing).
+#[test]
+fn the_ci_baselines_of_different_cpus_agree_but_for_timing() {
+    let all: Vec<Report> = ci_baselines()
+        .iter()
+        .map(|p| Report::read(p).unwrap_or_else(|e| panic!("{}: {e:#}", p.display())))
+        .collect();
+    for a in &all {
+        for b in &all {
+            let c = compare(a, b, &CompareOptions::default());
+            assert_eq!(
+                c.regressions(),
+                0,
+                "{} against {}: {:?}",
+                a.header.environment.cpu_model,
+                b.header.environment.cpu_model,
+                c.findings
+                    .iter()
+                    .filter(|f| f.severity == Severity::Regression)
+                    .collect::<Vec<_>>()
+            );
+        }
+    }
 }
 
 #[test]
 fn the_ci_baseline_against_itself_fits_a_pull_request_comment_verdict_first() {
     use raybench_harness::output::compare_table::{MARKDOWN_LIMIT, MarkdownLimits, markdown};
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/baseline/ci.json");
-    let ci = Report::read(&path).expect("reports/baseline/ci.json reads");
+    let path = ci_baselines().remove(0);
+    let ci = Report::read(&path).expect("the CI baseline reads");
     let opts = CompareOptions::default();
     let c = compare(&ci, &ci, &opts);
     assert_eq!(c.regressions(), 0);

@@ -145,6 +145,38 @@ fn a_timing_only_failure_names_its_structures() {
     assert_eq!(c.timing_only(), None, "{}", text(&c));
 }
 
+/// Reports timed on different CPU models: a slowdown is advisory (a ratio to the reference
+/// does not carry from one CPU to another), with a note naming both CPUs, while a changed
+/// counter still fails; on the same CPU the same slowdown fails.
+#[test]
+fn timing_on_another_cpu_is_advisory_and_counters_still_gate() {
+    let mut new = base().clone();
+    slow(&mut new, "bvh-binned");
+    assert_eq!(compare(base(), &new, &strict()).regressions(), 1);
+    new.header.environment.cpu_model = format!("not {}", base().header.environment.cpu_model);
+    let c = compare(base(), &new, &strict());
+    assert_eq!(c.regressions(), 0, "{}", text(&c));
+    assert!(
+        c.findings
+            .iter()
+            .any(|f| f.severity == Severity::Advisory && f.at.contains("/ bvh-binned /")),
+        "{}",
+        text(&c)
+    );
+    assert!(
+        c.findings.iter().any(|f| f.severity == Severity::Note
+            && f.what.contains("timing slowdowns are advisory")
+            && f.what.contains(&new.header.environment.cpu_model)),
+        "{}",
+        text(&c)
+    );
+    let w = &mut entry(&mut new, "bvh-binned").workloads[1];
+    w.counters_total.as_mut().unwrap().nodes += 1;
+    let c = compare(base(), &new, &strict());
+    assert!(c.regressions() >= 1, "{}", text(&c));
+    assert_eq!(c.timing_only(), None, "{}", text(&c));
+}
+
 /// `--timing-regressions-to FILE`: the list on a timing-only failure (exit 2), no file after a
 /// pass (a stale list removed), and an error naming the flag when FILE is a directory.
 #[test]

@@ -180,6 +180,27 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
         }
     }
     let comparable = environment_warnings(base, new, opts, &mut findings);
+    let cross_cpu = CompareOptions {
+        timing_advisory: true,
+        ..*opts
+    };
+    let opts = if other_cpu(base, new) && !opts.timing_advisory {
+        findings.push(Finding::about(
+            Severity::Note,
+            "",
+            format!(
+                "timing slowdowns are advisory: the base was timed on `{}`, the new report on \
+                 `{}`, and a ratio to the reference is not portable between CPUs (one unchanged \
+                 build moved brute force's ratio to Embree by a factor of two from an AMD EPYC \
+                 to an Intel Xeon); correctness and deterministic figures are gated as always. \
+                 A baseline made on this CPU (scripts/update-baseline) gates timing here",
+                base.header.environment.cpu_model, new.header.environment.cpu_model
+            ),
+        ));
+        &cross_cpu
+    } else {
+        opts
+    };
     for e in &new.errors {
         findings.push(Finding::about(
             Severity::Regression,
@@ -263,6 +284,11 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
     }
     findings.sort_by_key(|f| f.severity);
     Comparison { rows, findings }
+}
+
+/// Whether the two reports were timed on different CPU models.
+pub fn other_cpu(base: &Report, new: &Report) -> bool {
+    base.header.environment.cpu_model != new.header.environment.cpu_model
 }
 
 /// Warns about different machines and settings; returns whether deterministic figures are
