@@ -2,7 +2,7 @@
 //! the geometric means the report's figures give, one table per scene, the SAH table and a
 //! link to the report; `--report-link` and `--headline-only` do what they say.
 
-mod common;
+use crate::common;
 
 use raybench_harness::pipeline::run::{RunOptions, run};
 use raybench_harness::report::run::Report;

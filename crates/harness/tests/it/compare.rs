@@ -1,8 +1,7 @@
 //! `raybench compare`: identical reports pass; a changed counter, a new mismatch, a changed SAH
 //! cost, a missing entry or a slowdown beyond the threshold fail; different settings are caught.
 
-#[path = "../common/mod.rs"]
-mod common;
+use crate::common;
 mod timing;
 
 use raybench_harness::output::compare_table::full_table;

@@ -7,7 +7,7 @@
 //! the list (and docs/structures.md, which reports it).
 #![cfg(feature = "peers")]
 
-mod common;
+use crate::common;
 
 use raybench_accel::Accel;
 use raybench_harness::output::summary::summary_table;

@@ -3,7 +3,7 @@
 //! settings and leaves one complete report. A second `--resume`, or a flag beside it, is
 //! refused.
 
-mod common;
+use crate::common;
 
 use raybench_harness::report::run::Report;
 use std::io::{BufRead, BufReader};

@@ -2,7 +2,7 @@
 //! registered entry is listed, run, timed and checked by the same command handlers as a
 //! built-in one (called as `cli::main_with` calls them, without a subprocess).
 
-mod common;
+use crate::common;
 
 use clap::Parser;
 use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit};

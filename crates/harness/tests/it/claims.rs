@@ -3,7 +3,7 @@
 //! hold"; a report without the structures a rule needs says "not measured"; and a real run
 //! stores its claims in report.json and shows them on the page.
 
-mod common;
+use crate::common;
 
 use raybench_harness::pipeline::run::run;
 use raybench_harness::report::claims::{Verdict, evaluate};

@@ -1,7 +1,7 @@
 //! `raybench history`: reports ordered by time; a changed counter and a ratio that left its
 //! interval are marked at the report where they happened; the page and the summary are written.
 
-mod common;
+use crate::common;
 
 use raybench_harness::output::history::{Entry, markdown, order, page, series};
 use raybench_harness::pipeline::run::{RunOptions, run};

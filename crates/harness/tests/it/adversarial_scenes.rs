@@ -2,7 +2,7 @@
 //! preset, every workload, checked against the reference. Each structure must build and agree
 //! (0 mismatches), or the report must carry an error naming the scene; never a panic.
 
-mod common;
+use crate::common;
 
 use raybench_harness::pipeline::run::{RunOptions, run};
 use raybench_harness::report::run::Report;

@@ -5,7 +5,7 @@
 //! pages rendered headless: not blank, the summary a few screens tall, the claims and the
 //! summary table in the rendered document.
 
-mod common;
+use crate::common;
 
 use raybench_harness::output::render::sweep::Sweep;
 use raybench_harness::output::render::{pictures, render};

@@ -2,7 +2,7 @@
 //! 1 thread twice and with 2 threads gives byte-identical dumps (every ray, every hit) and
 //! identical counters, for every registered structure.
 
-mod common;
+use crate::common;
 
 use raybench_harness::Registry;
 use raybench_harness::pipeline::dump::{read_dump, read_index};

@@ -4,9 +4,7 @@
 //! control characters. Each ends in a clear error (or a clean stop) within seconds, before any
 //! output is written; none hangs, aborts or loses a report.
 
-mod common;
-
-use common::{assert_clear_error, files_below, invoke, raybench, scratch};
+use crate::common::{assert_clear_error, files_below, invoke, raybench, scratch};
 use std::path::Path;
 use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};

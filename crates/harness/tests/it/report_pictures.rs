@@ -3,9 +3,7 @@
 //! structure disagrees) without changing a timed workload's counters or agreement;
 //! `raybench report` copies them with a report, or draws the small planes and says so.
 
-mod common;
-
-use common::{files_below, invoke, scratch};
+use crate::common::{files_below, invoke, scratch};
 use raybench_harness::report::run::Report;
 use std::path::Path;
 

@@ -4,7 +4,7 @@
 //! synthetic (one small real run cloned into made-up scenes and numbers), so the exponent
 //! every structure should show is known.
 
-mod common;
+use crate::common;
 
 use raybench_harness::output::render::palette::{self, Palette};
 use raybench_harness::output::render::render;

@@ -1,11 +1,9 @@
 //! End-to-end: `run` on small procedural scenes against Embree, the report round-trip, and
 //! determinism of rays and counters.
 
-use raybench_harness::report::run::Report;
-mod common;
-
-use common::options;
+use crate::common::options;
 use raybench_harness::pipeline::run::run;
+use raybench_harness::report::run::Report;
 use raybench_scenes::SceneRequest;
 use raybench_scenes::Workload;
 use std::path::PathBuf;

@@ -1,8 +1,6 @@
 //! The `raybench` binary as a user runs it.
 
-mod common;
-
-use common::{assert_clear_error, files_below, invoke, raybench, scratch};
+use crate::common::{assert_clear_error, files_below, invoke, raybench, scratch};
 
 #[test]
 fn list_names_structures_workloads_and_suites() {

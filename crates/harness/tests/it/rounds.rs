@@ -1,7 +1,7 @@
 //! Interleaved rounds: every timed pass is kept, ratios come with intervals, and with a time
 //! budget the extra rounds keep the reference paired with everyone who takes part.
 
-mod common;
+use crate::common;
 
 use raybench_harness::pipeline::run::{RunOptions, run};
 use raybench_scenes::{SceneRequest, Workload};

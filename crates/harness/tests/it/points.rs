@@ -1,6 +1,6 @@
 //! Closest-point workloads through the harness: measured, counted and validated like rays.
 
-mod common;
+use crate::common;
 
 use raybench_harness::Registry;
 use raybench_harness::pipeline::check::check_points;
