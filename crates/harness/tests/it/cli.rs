@@ -165,8 +165,7 @@ fn the_ci_suite_runs_end_to_end_with_zero_mismatches() {
 /// naming the scene and the limit; naming it with `--structures` runs it everywhere.
 #[test]
 fn a_suite_skips_brute_force_past_its_limit_and_says_so() {
-    let dir = std::env::temp_dir().join(format!("raybench-suite-limit-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("suite-limit");
     std::fs::write(
         dir.join("limits.json"),
         r#"{"name": "limits", "description": "brute force past its suite limit",
