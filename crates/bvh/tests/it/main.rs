@@ -1,0 +1,10 @@
+//! The bvh crate's integration tests in one binary, a module per file: the walks, generic over
+//! the node width and kernel, are compiled once for all of them instead of once per binary.
+
+mod conformance;
+mod packet_floors;
+mod packets_any_hit;
+mod packets_frustum;
+mod quantized;
+mod reinsert;
+mod sbvh;
