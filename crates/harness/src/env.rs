@@ -29,6 +29,16 @@ pub struct Environment {
     pub ftz: bool,
     pub daz: bool,
     pub mxcsr: String,
+    /// The kernel's transparent huge page mode (`always`, `madvise` or `never`, from
+    /// /sys/kernel/mm/transparent_hugepage/enabled), absent where the kernel has none. Embree's
+    /// allocator asks for huge pages for its structures' memory, ours do not, so under
+    /// `madvise` only Embree's get them (docs/methodology.md, "Memory pages").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transparent_hugepages: Option<String>,
+    /// `GLIBC_TUNABLES` when set: `glibc.malloc.hugetlb=1` there gives our structures' large
+    /// arrays huge pages too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub glibc_tunables: Option<String>,
     pub embree: EmbreeInfo,
 }
 
@@ -60,6 +70,13 @@ fn os_name() -> String {
         Some(kernel) => format!("{pretty}, kernel {kernel}"),
         None => pretty,
     }
+}
+
+/// The selected mode of a sysfs choice list such as `always [madvise] never`: the bracketed word.
+fn selected_mode(list: &str) -> Option<String> {
+    let start = list.find('[')? + 1;
+    let len = list[start..].find(']')?;
+    Some(list[start..start + len].to_string())
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -147,6 +164,9 @@ impl Environment {
             ftz: mxcsr & (1 << 15) != 0,
             daz: mxcsr & (1 << 6) != 0,
             mxcsr: format!("{mxcsr:#06x}"),
+            transparent_hugepages: read_trimmed("/sys/kernel/mm/transparent_hugepage/enabled")
+                .and_then(|l| selected_mode(&l)),
+            glibc_tunables: std::env::var("GLIBC_TUNABLES").ok(),
             embree,
         }
     }
@@ -161,5 +181,19 @@ mod tests {
         assert_eq!(civil_from_days(0), (1970, 1, 1));
         assert_eq!(civil_from_days(11_016), (2000, 2, 29));
         assert_eq!(civil_from_days(20_778), (2026, 11, 21));
+    }
+
+    #[test]
+    fn the_selected_huge_page_mode_is_the_bracketed_one() {
+        assert_eq!(
+            selected_mode("always [madvise] never").as_deref(),
+            Some("madvise")
+        );
+        assert_eq!(
+            selected_mode("[always] madvise never").as_deref(),
+            Some("always")
+        );
+        assert_eq!(selected_mode("always madvise never"), None);
+        assert_eq!(selected_mode("always [madvise"), None);
     }
 }

@@ -13,7 +13,14 @@ use std::fmt::Write as _;
 const GROUPS: [(&str, &[&str]); 4] = [
     (
         "Machine",
-        &["cpu_model", "cores", "cpu_flags", "os", "hostname"],
+        &[
+            "cpu_model",
+            "cores",
+            "cpu_flags",
+            "os",
+            "hostname",
+            "transparent_hugepages",
+        ],
     ),
     (
         "Build",
@@ -34,6 +41,7 @@ const GROUPS: [(&str, &[&str]); 4] = [
             "ftz",
             "daz",
             "mxcsr",
+            "glibc_tunables",
         ],
     ),
     ("Embree", &["embree"]),
@@ -74,6 +82,8 @@ fn label(key: &str) -> String {
         "ftz" => "flush to zero (FTZ)",
         "daz" => "denormals are zero (DAZ)",
         "mxcsr" => "MXCSR register",
+        "transparent_hugepages" => "transparent huge pages (kernel mode)",
+        "glibc_tunables" => "GLIBC_TUNABLES",
         "config" => "device configuration",
         "tasking_system" => "tasking system",
         "ray_mask_supported" => "ray masks compiled in",

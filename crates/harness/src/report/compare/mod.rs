@@ -315,7 +315,12 @@ fn environment_warnings(
         ("profile", be.profile.clone(), ne.profile.clone()),
         ("MXCSR", be.mxcsr.clone(), ne.mxcsr.clone()),
     ];
-    for (what, b, n) in machine {
+    // Huge pages only where both reports say: older reports lack the field.
+    let pages = match (&be.transparent_hugepages, &ne.transparent_hugepages) {
+        (Some(b), Some(n)) => Some(("transparent huge pages", b.clone(), n.clone())),
+        _ => None,
+    };
+    for (what, b, n) in machine.into_iter().chain(pages) {
         if b != n {
             findings.push(Finding::about(
                 Severity::Note,
