@@ -367,6 +367,12 @@ fn own_structures() -> Vec<StructureEntry> {
             embree(EmbreeParams::medium_packet16()),
         ),
         register::<EmbreeScene>(
+            "embree-medium-avx2",
+            "embree-medium on Embree's AVX2 kernels (isa=avx2) instead of the widest the CPU has: what Embree's own choice of kernels buys on this machine, and a race on the instructions the 8-wide trees' walks use",
+            None,
+            embree(EmbreeParams::medium_on("avx2")),
+        ),
+        register::<EmbreeScene>(
             "embree-high",
             "Embree 3 BVH, RTC_BUILD_QUALITY_HIGH (spatial splits)",
             None,
