@@ -1,5 +1,5 @@
 //! Criterion benches of every native family: building on the bunny and tracing 100k seeded
-//! random rays through it, per named variant. `cargo bench -p raybench-harness`. The harness's
+//! random rays through it, per named variant. `cargo bench -p raybench-bench`. The harness's
 //! `raybench run` is the benchmark of record (same rays for every structure, checked against
 //! Embree); these are for quick local comparisons of one family's variants.
 
