@@ -13,6 +13,7 @@ mod interrupt;
 mod peers;
 mod points;
 mod registry;
+mod report_browser;
 mod report_pictures;
 mod report_render;
 mod report_sweeps;
