@@ -3,7 +3,7 @@
 //! and the agreement sentence (what the README shows).
 
 use crate::atomic::write_atomic;
-use crate::output::results::{headline, results_page};
+use crate::output::results::{against_group, headline, results_page};
 use crate::report::run::Report;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -25,7 +25,8 @@ pub struct ResultsArgs {
     #[arg(long)]
     headline_only: bool,
     /// Repeat the headline relative to this structure of the run too (e.g. embree-high);
-    /// comma-separated or repeated.
+    /// comma-separated or repeated. Structures joined by `+` are raced as one, the faster of
+    /// them on each scene and workload (e.g. embree-medium-stream+embree-medium-packet16).
     #[arg(long, value_delimiter = ',')]
     also_against: Vec<String>,
 }
@@ -33,11 +34,22 @@ pub struct ResultsArgs {
 pub fn run(args: ResultsArgs) -> Result<ExitCode> {
     let report = Report::read(&args.report)?;
     for other in &args.also_against {
-        if !report.results.iter().any(|r| &r.structure == other) {
-            anyhow::bail!(
-                "--also-against {other}: {} has no results of '{other}'",
-                args.report.display()
-            );
+        let group = against_group(other);
+        for (i, name) in group.iter().enumerate() {
+            if name.is_empty() {
+                anyhow::bail!(
+                    "--also-against {other}: an empty structure name (`+` joins two names)"
+                );
+            }
+            if group[..i].contains(name) {
+                anyhow::bail!("--also-against {other}: '{name}' is named twice");
+            }
+            if !report.results.iter().any(|r| r.structure == *name) {
+                anyhow::bail!(
+                    "--also-against {other}: {} has no results of '{name}'",
+                    args.report.display()
+                );
+            }
         }
     }
     let page_dir = match args.out.as_deref().and_then(Path::parent) {

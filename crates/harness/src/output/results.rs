@@ -61,26 +61,42 @@ pub fn scene_ratios(report: &Report) -> Vec<SceneRatios> {
 /// each scene (the run's reference, or another structure of the same run such as embree-high:
 /// the ratios are as fair, from the same run).
 pub fn scene_ratios_to(report: &Report, reference: &str) -> Vec<SceneRatios> {
-    let reference_on = |scene: &str| {
+    scene_ratios_to_best(report, &[reference])
+}
+
+/// Every structure of the run but those of `group`, with its ratios, on each scene, to the
+/// best of `group` there: per workload the highest median throughput among them, the shortest
+/// median build and the smallest memory (a group of one is [`scene_ratios_to`]). So an entry
+/// races, scene by scene, whichever of several ways of calling one library is faster there,
+/// as Embree's stream and 16-ray packet calls are for coherent rays.
+pub fn scene_ratios_to_best(report: &Report, group: &[&str]) -> Vec<SceneRatios> {
+    let group_on = |scene: &str| -> Vec<&ResultEntry> {
         report
             .results
             .iter()
-            .find(|r| r.scene == scene && r.structure == reference)
+            .filter(|r| r.scene == scene && group.contains(&r.structure.as_str()))
+            .collect()
     };
     let ratio = |x: f64, base: f64| (base > 0.0).then(|| x / base);
+    let best = |values: Vec<f64>, higher: bool| {
+        values
+            .into_iter()
+            .filter(|v| *v > 0.0)
+            .reduce(|a, b| if (b > a) == higher { b } else { a })
+    };
     structure_names(report)
         .into_iter()
-        .filter(|s| s != reference)
+        .filter(|s| !group.contains(&s.as_str()))
         .map(|structure| {
             let entries: Vec<&ResultEntry> = report
                 .results
                 .iter()
                 .filter(|r| r.structure == structure)
                 .collect();
-            let per_scene = |f: &dyn Fn(&ResultEntry, &ResultEntry) -> Option<f64>| {
+            let per_scene = |f: &dyn Fn(&ResultEntry, &[&ResultEntry]) -> Option<f64>| {
                 entries
                     .iter()
-                    .filter_map(|r| Some((f(r, reference_on(&r.scene)?)?, r.scene.clone())))
+                    .filter_map(|r| Some((f(r, &group_on(&r.scene))?, r.scene.clone())))
                     .collect::<Vec<(f64, String)>>()
             };
             let workloads = report
@@ -88,25 +104,28 @@ pub fn scene_ratios_to(report: &Report, reference: &str) -> Vec<SceneRatios> {
                 .workloads
                 .iter()
                 .map(|wl| {
-                    per_scene(&|r: &ResultEntry, base: &ResultEntry| {
-                        let of = |e: &ResultEntry| {
-                            Some(
-                                e.workloads
-                                    .iter()
-                                    .find(|w| &w.workload == wl)?
-                                    .mqueries_per_s
-                                    .median,
-                            )
-                        };
-                        ratio(of(r)?, of(base)?)
+                    let of = |e: &ResultEntry| {
+                        Some(
+                            e.workloads
+                                .iter()
+                                .find(|w| &w.workload == wl)?
+                                .mqueries_per_s
+                                .median,
+                        )
+                    };
+                    per_scene(&|r: &ResultEntry, bases: &[&ResultEntry]| {
+                        let base = best(bases.iter().filter_map(|b| of(b)).collect(), true)?;
+                        ratio(of(r)?, base)
                     })
                 })
                 .collect();
-            let build = per_scene(&|r: &ResultEntry, base: &ResultEntry| {
-                ratio(r.build.median_ms, base.build.median_ms)
+            let build = per_scene(&|r: &ResultEntry, bases: &[&ResultEntry]| {
+                let base = best(bases.iter().map(|b| b.build.median_ms).collect(), false)?;
+                ratio(r.build.median_ms, base)
             });
-            let memory = per_scene(&|r: &ResultEntry, base: &ResultEntry| {
-                ratio(r.memory_bytes as f64, base.memory_bytes as f64)
+            let memory = per_scene(&|r: &ResultEntry, bases: &[&ResultEntry]| {
+                let base = best(bases.iter().map(|b| b.memory_bytes as f64).collect(), false)?;
+                ratio(r.memory_bytes as f64, base)
             });
             SceneRatios {
                 structure,
@@ -126,8 +145,13 @@ pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
 
 /// [`headline_rows`] relative to `reference`, another structure of the same run.
 pub fn headline_rows_to(report: &Report, reference: &str) -> Vec<HeadlineRow> {
+    headline_rows_to_best(report, &[reference])
+}
+
+/// [`headline_rows`] relative to the best of `group` on each scene ([`scene_ratios_to_best`]).
+pub fn headline_rows_to_best(report: &Report, group: &[&str]) -> Vec<HeadlineRow> {
     let mean = |v: &[(f64, String)]| geometric_mean(v.iter().map(|(x, _)| *x));
-    scene_ratios_to(report, reference)
+    scene_ratios_to_best(report, group)
         .into_iter()
         .map(|r| HeadlineRow {
             workloads: r.workloads.iter().map(|w| mean(w)).collect(),
@@ -188,13 +212,14 @@ pub(crate) fn cell(x: Option<f64>) -> String {
 /// The headline table and the agreement sentence (what `--headline-only` prints, for pasting
 /// into the README).
 pub fn headline(report: &Report) -> String {
-    let mut s = headline_table(report, &report.run.reference);
+    let mut s = headline_table(report, &[&report.run.reference]);
     let _ = writeln!(s, "\n{}", agreement_line(report));
     s
 }
 
-/// The headline's table (and which structures ran on fewer scenes) relative to `reference`.
-fn headline_table(report: &Report, reference: &str) -> String {
+/// The headline's table (and which structures ran on fewer scenes) relative to the best of
+/// `group` on each scene (one structure, usually).
+fn headline_table(report: &Report, group: &[&str]) -> String {
     let mut s = String::new();
     let workloads = &report.run.workloads;
     s.push_str("| structure |");
@@ -204,7 +229,7 @@ fn headline_table(report: &Report, reference: &str) -> String {
     s.push_str(" build | memory |\n|---|");
     s.push_str(&"---:|".repeat(workloads.len() + 2));
     s.push('\n');
-    let rows = headline_rows_to(report, reference);
+    let rows = headline_rows_to_best(report, group);
     let mut peers_heading = PeersHeading::default();
     for row in &rows {
         peers_heading.before(&mut s, &row.structure, workloads.len() + 2);
@@ -273,7 +298,8 @@ fn agreement_line(report: &Report) -> String {
 
 /// The whole page; `report_link` is where the heading's link to the report points, and
 /// `also_against` names other structures of the run the headline is repeated against (say
-/// embree-high beside the reference embree-medium).
+/// embree-high beside the reference embree-medium), each one structure or a group joined by
+/// [`GROUP_JOIN`] (the best of them on each scene: [`scene_ratios_to_best`]).
 pub fn results_page(report: &Report, report_link: &str, also_against: &[String]) -> String {
     let env = &report.header.environment;
     let run = &report.run;
@@ -312,12 +338,24 @@ pub fn results_page(report: &Report, report_link: &str, also_against: &[String])
     );
     s.push_str(&headline(report));
     for other in also_against {
-        let _ = writeln!(
-            s,
-            "\n## Against `{other}`\n\nThe headline's geometric means relative to `{other}` \
-             in the same run (its medians on each scene).\n"
-        );
-        s.push_str(&headline_table(report, other));
+        let group = against_group(other);
+        if let [one] = group[..] {
+            let _ = writeln!(
+                s,
+                "\n## Against `{one}`\n\nThe headline's geometric means relative to `{one}` \
+                 in the same run (its medians on each scene).\n"
+            );
+        } else {
+            let names = names_text(&group);
+            let _ = writeln!(
+                s,
+                "\n## Against the faster of {names}\n\nThe headline's geometric means \
+                 relative to, on each scene and workload, the faster of {names} in the same \
+                 run: the higher of their median throughputs (for build time and memory, the \
+                 lower), so each entry races whichever of them does best there.\n"
+            );
+        }
+        s.push_str(&headline_table(report, &group));
     }
     claims_table(&mut s, report);
     scene_tables(&mut s, report);
@@ -333,6 +371,23 @@ pub fn results_page(report: &Report, report_link: &str, also_against: &[String])
         }
     }
     s
+}
+
+/// Joins the structures of an `--also-against` group: `embree-medium-stream+embree-medium-packet16`.
+pub const GROUP_JOIN: char = '+';
+
+/// The structures an `--also-against` value names: one, or a group joined by [`GROUP_JOIN`].
+pub fn against_group(value: &str) -> Vec<&str> {
+    value.split(GROUP_JOIN).collect()
+}
+
+/// "`a`", "`a` and `b`", "`a`, `b` and `c`".
+fn names_text(names: &[&str]) -> String {
+    let quoted: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    match quoted.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => quoted.concat(),
+    }
 }
 
 /// The claims this run decided (none listed when it measured none): claim, figures, verdict.

@@ -15,12 +15,18 @@ const SCENES: [&str; 2] = ["soup:triangles=300", "sphere:triangles=300"];
 /// A two-scene run of bvh-binned against embree-medium, written as
 /// `ROOT/reports/small/report.json`.
 fn report_in(root: &Path) -> (Report, PathBuf) {
+    report_of(root, &["bvh-binned", "embree-medium"])
+}
+
+/// A two-scene run of `structures` (embree-medium the reference), written as
+/// `ROOT/reports/small/report.json`.
+fn report_of(root: &Path, structures: &[&str]) -> (Report, PathBuf) {
     let options = RunOptions {
         workloads: vec![Workload::Primary, Workload::Random, Workload::PointsNear],
         rays: 1000,
         points: 200,
         images: false,
-        ..common::options(&["bvh-binned", "embree-medium"])
+        ..common::options(structures)
     };
     let requests = SCENES.map(|s| SceneRequest::Spec(s.into()));
     let report = run(&options, &requests).unwrap();
@@ -245,5 +251,88 @@ fn the_page_has_the_headline_scene_and_sah_tables_and_links_the_report() {
         !out.status.success() && err.contains("--also-against kd-sah"),
         "{err}"
     );
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// `--also-against a+b`: every other structure's ratios are to the faster of the two on each
+/// scene and workload (the shorter build, the smaller memory), the two have no row, and a
+/// group with an empty, repeated or absent name is refused, naming the flag's value.
+#[test]
+fn a_group_is_raced_as_the_faster_of_its_structures_on_each_scene() {
+    let root = std::env::temp_dir().join(format!("raybench-results-group-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let (report, path) = report_of(&root, &["bvh-binned", "bvh-median", "embree-medium"]);
+    let page = raybench(&[
+        "results",
+        path.to_str().unwrap(),
+        "--also-against",
+        "bvh-median+embree-medium",
+    ]);
+    let title = "## Against the faster of `bvh-median` and `embree-medium`";
+    let against = &page[page.find(title).expect(&page)..page.find("## Scenes").unwrap()];
+    let on = |structure: &str, scene: &str| {
+        report
+            .results
+            .iter()
+            .find(|r| r.structure == structure && r.scene == scene)
+            .unwrap()
+    };
+    let mut cells = Vec::new();
+    for wl in ["primary", "random", "points-near"] {
+        let rate = |structure: &str, scene: &str| {
+            let r = on(structure, scene);
+            r.workloads
+                .iter()
+                .find(|w| w.workload == wl)
+                .unwrap()
+                .mqueries_per_s
+                .median
+        };
+        let ratios: Vec<f64> = SCENES
+            .iter()
+            .map(|scene| {
+                let best = rate("bvh-median", scene).max(rate("embree-medium", scene));
+                rate("bvh-binned", scene) / best
+            })
+            .collect();
+        cells.push(format!("{:.2}", geometric_mean(&ratios)));
+    }
+    let build: Vec<f64> = SCENES
+        .iter()
+        .map(|scene| {
+            let ms = |s: &str| on(s, scene).build.median_ms;
+            ms("bvh-binned") / ms("bvh-median").min(ms("embree-medium"))
+        })
+        .collect();
+    let memory: Vec<f64> = SCENES
+        .iter()
+        .map(|scene| {
+            let bytes = |s: &str| on(s, scene).memory_bytes as f64;
+            bytes("bvh-binned") / bytes("bvh-median").min(bytes("embree-medium"))
+        })
+        .collect();
+    cells.push(format!("{:.2}", geometric_mean(&build)));
+    cells.push(format!("{:.2}", geometric_mean(&memory)));
+    let row = format!("| bvh-binned | {} |", cells.join(" | "));
+    assert!(against.contains(&row), "{row}\n{against}");
+    assert!(!against.contains("| bvh-median |"), "{against}");
+    assert!(!against.contains("| embree-medium |"), "{against}");
+
+    for (value, says) in [
+        ("bvh-median+", "an empty structure name"),
+        ("bvh-median+bvh-median", "'bvh-median' is named twice"),
+        ("bvh-median+kd-sah", "has no results of 'kd-sah'"),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_raybench"))
+            .args(["results", path.to_str().unwrap(), "--also-against", value])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{value}: accepted");
+        assert!(
+            err.contains(&format!("--also-against {value}")) && err.contains(says),
+            "{value}: {err}"
+        );
+    }
     std::fs::remove_dir_all(&root).unwrap();
 }
