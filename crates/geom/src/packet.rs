@@ -197,20 +197,34 @@ impl Best {
     }
 
     /// Every triangle of `tri4` against the `active` lanes, one triangle a pass; a lane's hit
-    /// replaces its best when `t_min < t <= best`.
+    /// replaces its best when `t_min < t <= best`. For an any-hit walk (`ANY_HIT`), whose
+    /// leaves mostly hold no triangle any of its rays hits, the (triangle, ray) pairs are
+    /// screened first when few lanes are active ([`PAIRED_RAYS`]), and only the triangles some
+    /// ray may hit take their pass, on those rays alone: the same answers. A closest-hit walk
+    /// meets hits more often, and there the screening cost more than it saved (measured: see
+    /// docs/experiments.md, "(triangle, ray) pairs screened").
     ///
     /// # Safety
     ///
     /// AVX-512F must be available: call it from code reached through an [`Avx512Packets`].
     #[target_feature(enable = "avx512f")]
-    pub fn test_tri4(&mut self, tri4: &Tri4, p: &Packet, active: u16) {
+    pub fn test_tri4<const ANY_HIT: bool>(&mut self, tri4: &Tri4, p: &Packet, active: u16) {
         // The four normals `e2 × e1` in one pass (the same operations as `cross`, so the same
         // bits), broadcast per triangle below.
         let ng4 = normals(tri4);
+        let lanes = if ANY_HIT && active.count_ones() <= PAIRED_RAYS {
+            self.candidates(tri4, &ng4, p, active)
+        } else {
+            [active; 4]
+        };
         for lane in 0..4 {
             let id = tri4.ids[lane];
             if id == NO_PRIM {
                 break;
+            }
+            let active = lanes[lane];
+            if active == 0 {
+                continue;
             }
             let at = |v: &[[f32; 4]; 3]| [0, 1, 2].map(|a| _mm512_set1_ps(v[a][lane]));
             let (v0, e1, e2, ng) = (at(&tri4.v0), at(&tri4.e1), at(&tri4.e2), at(&ng4));
@@ -240,6 +254,77 @@ impl Best {
             self.v = _mm512_mask_mov_ps(self.v, hit, _mm512_mul_ps(v, inv));
             self.prim = _mm512_mask_mov_epi32(self.prim, hit, _mm512_set1_epi32(id as i32));
         }
+    }
+}
+
+/// Active rays up to which [`Best::test_tri4`] screens (triangle, ray) pairs first, four rays
+/// against the four triangles in one 16-lane pass (more rays take a pass per four), instead of
+/// each triangle against all sixteen lanes. Four and eight measured alike on the shadow rays
+/// of ten scenes (docs/experiments.md, "(triangle, ray) pairs screened"); four takes one pass.
+const PAIRED_RAYS: u32 = 4;
+
+impl Best {
+    /// For each triangle of `tri4` (normals `ng4`), the `active` lanes whose ray may hit it
+    /// below its current best: every pair (triangle `k`, ray) is tested in SIMD lane `4 j + k`
+    /// of a pass over four of the rays, with the operations of the one-triangle pass in
+    /// [`Best::test_tri4`], so a pair's edge tests and `t` have the same bits there. Its window
+    /// is the best before the `Tri4`, which the `Tri4`'s own hits can only shrink, so every lane
+    /// that the one-triangle pass would find is among those returned, and that pass, run on
+    /// them alone, answers as it would on all the active lanes.
+    #[target_feature(enable = "avx512f")]
+    fn candidates(&self, tri4: &Tri4, ng4: &[[f32; 4]; 3], p: &Packet, active: u16) -> [u16; 4] {
+        let rays = active.count_ones();
+        // The active lanes' numbers, packed from SIMD lane 0.
+        let iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+        let packed = _mm512_maskz_compress_epi32(active, iota);
+        let mut number = [0u32; PACKET];
+        // SAFETY: `number` is 16 writable 4-byte values; `storeu` has no alignment requirement.
+        unsafe { _mm512_storeu_si512(number.as_mut_ptr().cast(), packed) };
+        // Each triangle's values repeated over the four groups of four SIMD lanes.
+        let four = |v: &[[f32; 4]; 3]| {
+            // SAFETY: each row is four initialised f32s; `loadu` has no alignment requirement.
+            [0, 1, 2].map(|a| _mm512_broadcast_f32x4(unsafe { _mm_loadu_ps(v[a].as_ptr()) }))
+        };
+        let (v0, e1, e2, ng) = (four(&tri4.v0), four(&tri4.e1), four(&tri4.e2), four(ng4));
+        // The triangles before the first empty slot, repeated for each ray.
+        let slots = tri4.ids.iter().take_while(|&&id| id != NO_PRIM).count();
+        let triangles = ((1u32 << slots) - 1) * 0x1111;
+        // Pair lane `4 j + k` takes ray `j` of the pass.
+        let ray_of = _mm512_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3);
+        let zero = _mm512_setzero_ps();
+        let mut out = [0u16; 4];
+        for pass in 0..rays.div_ceil(4) {
+            let first = 4 * pass;
+            let which = _mm512_add_epi32(ray_of, _mm512_set1_epi32(first as i32));
+            let lane = _mm512_permutexvar_epi32(which, packed);
+            let of = |v: __m512| _mm512_permutexvar_ps(lane, v);
+            let (origin, dir) = (p.origin.map(of), p.dir.map(of));
+            let in_pass = (rays - first).min(4);
+            let pairs = (((1u32 << (4 * in_pass)) - 1) & triangles) as u16;
+            let c = [0, 1, 2].map(|a| _mm512_sub_ps(v0[a], origin[a]));
+            let rr = cross(&c, &dir);
+            let den = dot(&ng, &dir);
+            let abs_den = _mm512_abs_ps(den);
+            let u = flip(dot(&rr, &e2), den);
+            let v = flip(dot(&rr, &e1), den);
+            let mut hit = _mm512_mask_cmp_ps_mask::<_CMP_NEQ_UQ>(pairs, den, zero);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, u, zero);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, v, zero);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, _mm512_add_ps(u, v), abs_den);
+            if hit == 0 {
+                continue;
+            }
+            let t = flip(dot(&ng, &c), den);
+            let (t_min, best) = (of(p.t_min), of(self.t));
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(hit, _mm512_mul_ps(abs_den, t_min), t);
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, t, _mm512_mul_ps(abs_den, best));
+            while hit != 0 {
+                let pair = hit.trailing_zeros() as usize;
+                hit &= hit - 1;
+                out[pair % 4] |= 1 << number[first as usize + pair / 4];
+            }
+        }
+        out
     }
 }
 
@@ -286,7 +371,75 @@ fn normals(t: &Tri4) -> [[f32; 4]; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Vec3;
+    use crate::rng::SplitMix64;
+    use crate::{MollerTriangle, Triangle, Vec3};
+
+    /// The any-hit test, which screens (triangle, ray) pairs when few lanes are active, leaves
+    /// every lane's best exactly as the unscreened test does: hit, `t`, `u` and `v` bit for bit
+    /// and the same triangle on ties (a triangle repeated in a later slot), over random
+    /// `Tri4`s with one to four triangles met one after another, windows that earlier hits
+    /// shrink, and active sets of every size.
+    #[test]
+    fn screened_pairs_answer_as_every_triangle_on_every_lane() {
+        if Avx512Packets::detect().is_none() {
+            eprintln!("no AVX-512F on this CPU: no packet is ever tested here");
+            return;
+        }
+        let mut rng = SplitMix64::new(5);
+        let (mut screened, mut hits) = (0, 0);
+        for case in 0..400 {
+            let near = |rng: &mut SplitMix64| rng.point_in(Vec3::splat(-1.0), Vec3::splat(1.0));
+            let tri4s: Vec<Tri4> = (0..3)
+                .map(|k| {
+                    let count = 1 + (case + k) % 4;
+                    let mut tris: Vec<(u32, MollerTriangle)> = (0..count)
+                        .map(|i| {
+                            let t = Triangle::new(near(&mut rng), near(&mut rng), near(&mut rng));
+                            ((10 * k + i) as u32, MollerTriangle::new(&t))
+                        })
+                        .collect();
+                    if count > 1 && case % 3 == 0 {
+                        // An exact tie: the first triangle again under another id.
+                        tris[count - 1].1 = tris[0].1;
+                    }
+                    Tri4::pack(&tris)
+                })
+                .collect();
+            let rays: Vec<Ray> = (0..PACKET)
+                .map(|_| {
+                    let origin = near(&mut rng) * 0.3 + Vec3::new(0.0, 0.0, 4.0);
+                    let dir = near(&mut rng) - origin;
+                    Ray::new(origin, dir, 0.0, rng.range(0.5, 1.2))
+                })
+                .collect();
+            let block = &RayPackets::new(&rays).blocks[0];
+            let active = (rng.next_u64() as u16) >> (case % 16);
+            let answers = |any_hit: bool| {
+                // SAFETY: AVX-512F was detected above.
+                unsafe {
+                    let (p, mut best) = load(block);
+                    for tri4 in &tri4s {
+                        if any_hit {
+                            best.test_tri4::<true>(tri4, &p, active);
+                        } else {
+                            best.test_tri4::<false>(tri4, &p, active);
+                        }
+                    }
+                    best.hits()
+                        .map(|(prim, h)| (prim, [h.t, h.u, h.v].map(f32::to_bits)))
+                }
+            };
+            let (plain, paired) = (answers(false), answers(true));
+            assert_eq!(plain, paired, "case {case}, lanes {active:016b}");
+            screened += (active.count_ones() <= PAIRED_RAYS) as usize;
+            hits += plain.iter().filter(|(prim, _)| *prim != NO_PRIM).count();
+        }
+        // Enough of both kinds for the comparison to mean something.
+        assert!(
+            screened > 100 && hits > 150,
+            "screened {screened}, hits {hits}"
+        );
+    }
 
     /// The loader's inverse directions are `Ray::inv_dir`'s, bit for bit, with zeros of both
     /// signs, subnormals and extremes among the components: a lane whose inverse differed by
