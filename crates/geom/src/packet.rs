@@ -196,38 +196,38 @@ impl Best {
         })
     }
 
-    /// Every triangle of `tri4` against the `active` lanes, one triangle a pass; a lane's hit
-    /// replaces its best when `t_min < t <= best`. For an any-hit walk (`ANY_HIT`), whose
-    /// leaves mostly hold no triangle any of its rays hits, the (triangle, ray) pairs are
-    /// screened first when few lanes are active ([`PAIRED_RAYS`]), and only the triangles some
-    /// ray may hit take their pass, on those rays alone: the same answers. A closest-hit walk
-    /// meets hits more often, and there the screening cost more than it saved (measured: see
-    /// docs/experiments.md, "(triangle, ray) pairs screened").
+    /// Every triangle of `tri4` against the `active` lanes; a lane's hit replaces its best when
+    /// `t_min < t <= best`, triangle after triangle in slot order. With many lanes active, one
+    /// triangle a sixteen-lane pass; with few ([`PAIRED_RAYS`]), the (triangle, ray) pairs in
+    /// one pass instead of four passes mostly idle (measured: see docs/experiments.md,
+    /// "(triangle, ray) pairs tested in one pass"). Both answer alike, bit for bit.
     ///
     /// # Safety
     ///
     /// AVX-512F must be available: call it from code reached through an [`Avx512Packets`].
     #[target_feature(enable = "avx512f")]
-    pub fn test_tri4<const ANY_HIT: bool>(&mut self, tri4: &Tri4, p: &Packet, active: u16) {
+    pub fn test_tri4(&mut self, tri4: &Tri4, p: &Packet, active: u16) {
         // The four normals `e2 × e1` in one pass (the same operations as `cross`, so the same
         // bits), broadcast per triangle below.
         let ng4 = normals(tri4);
-        let lanes = if ANY_HIT && active.count_ones() <= PAIRED_RAYS {
-            self.candidates(tri4, &ng4, p, active)
+        if active.count_ones() <= PAIRED_RAYS {
+            self.pairs(tri4, &ng4, p, active);
         } else {
-            [active; 4]
-        };
+            self.each_triangle(tri4, &ng4, p, active);
+        }
+    }
+
+    /// Each triangle of `tri4` (normals `ng4`) against the `active` lanes, one a sixteen-lane
+    /// pass.
+    #[target_feature(enable = "avx512f")]
+    fn each_triangle(&mut self, tri4: &Tri4, ng4: &[[f32; 4]; 3], p: &Packet, active: u16) {
         for lane in 0..4 {
             let id = tri4.ids[lane];
             if id == NO_PRIM {
                 break;
             }
-            let active = lanes[lane];
-            if active == 0 {
-                continue;
-            }
             let at = |v: &[[f32; 4]; 3]| [0, 1, 2].map(|a| _mm512_set1_ps(v[a][lane]));
-            let (v0, e1, e2, ng) = (at(&tri4.v0), at(&tri4.e1), at(&tri4.e2), at(&ng4));
+            let (v0, e1, e2, ng) = (at(&tri4.v0), at(&tri4.e1), at(&tri4.e2), at(ng4));
             let c = [0, 1, 2].map(|a| _mm512_sub_ps(v0[a], p.origin[a]));
             let rr = cross(&c, &p.dir);
             let den = dot(&ng, &p.dir);
@@ -257,42 +257,35 @@ impl Best {
     }
 }
 
-/// Active rays up to which [`Best::test_tri4`] screens (triangle, ray) pairs first, four rays
-/// against the four triangles in one 16-lane pass (more rays take a pass per four), instead of
-/// each triangle against all sixteen lanes. Four and eight measured alike on the shadow rays
-/// of ten scenes (docs/experiments.md, "(triangle, ray) pairs screened"); four takes one pass.
+/// Active rays up to which [`Best::test_tri4`] tests (triangle, ray) pairs: four rays against
+/// the four triangles fill the sixteen lanes of one pass (more rays would take a pass per four).
 const PAIRED_RAYS: u32 = 4;
 
 impl Best {
-    /// For each triangle of `tri4` (normals `ng4`), the `active` lanes whose ray may hit it
-    /// below its current best: every pair (triangle `k`, ray) is tested in SIMD lane `4 j + k`
-    /// of a pass over four of the rays, with the operations of the one-triangle pass in
-    /// [`Best::test_tri4`], so a pair's edge tests and `t` have the same bits there. Its window
-    /// is the best before the `Tri4`, which the `Tri4`'s own hits can only shrink, so every lane
-    /// that the one-triangle pass would find is among those returned, and that pass, run on
-    /// them alone, answers as it would on all the active lanes.
+    /// [`Best::test_tri4`] for few `active` lanes: each pair (triangle `k`, ray `j` of four) in
+    /// SIMD lane `4 j + k` of one pass, with the operations of the one-triangle pass
+    /// ([`Best::each_triangle`]), so each pair's edge tests, `t`, `u` and `v` have its bits. The
+    /// pass screens with each ray's best before the `Tri4`; the pairs left are then taken in the
+    /// one-triangle passes' order (a ray's triangles in slot order) against the best as those
+    /// passes would leave it, in scalar: the same IEEE operations, so the same answers, ties
+    /// included. Mostly no pair is left: a ray hits few of the triangles it meets.
     #[target_feature(enable = "avx512f")]
-    fn candidates(&self, tri4: &Tri4, ng4: &[[f32; 4]; 3], p: &Packet, active: u16) -> [u16; 4] {
+    fn pairs(&mut self, tri4: &Tri4, ng4: &[[f32; 4]; 3], p: &Packet, active: u16) {
         let rays = active.count_ones();
-        // The active lanes' numbers, packed from SIMD lane 0.
         let iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
         let packed = _mm512_maskz_compress_epi32(active, iota);
         let mut number = [0u32; PACKET];
         // SAFETY: `number` is 16 writable 4-byte values; `storeu` has no alignment requirement.
         unsafe { _mm512_storeu_si512(number.as_mut_ptr().cast(), packed) };
-        // Each triangle's values repeated over the four groups of four SIMD lanes.
         let four = |v: &[[f32; 4]; 3]| {
             // SAFETY: each row is four initialised f32s; `loadu` has no alignment requirement.
             [0, 1, 2].map(|a| _mm512_broadcast_f32x4(unsafe { _mm_loadu_ps(v[a].as_ptr()) }))
         };
         let (v0, e1, e2, ng) = (four(&tri4.v0), four(&tri4.e1), four(&tri4.e2), four(ng4));
-        // The triangles before the first empty slot, repeated for each ray.
         let slots = tri4.ids.iter().take_while(|&&id| id != NO_PRIM).count();
         let triangles = ((1u32 << slots) - 1) * 0x1111;
-        // Pair lane `4 j + k` takes ray `j` of the pass.
         let ray_of = _mm512_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3);
         let zero = _mm512_setzero_ps();
-        let mut out = [0u16; 4];
         for pass in 0..rays.div_ceil(4) {
             let first = 4 * pass;
             let which = _mm512_add_epi32(ray_of, _mm512_set1_epi32(first as i32));
@@ -315,16 +308,42 @@ impl Best {
                 continue;
             }
             let t = flip(dot(&ng, &c), den);
-            let (t_min, best) = (of(p.t_min), of(self.t));
+            let t_min = of(p.t_min);
             hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(hit, _mm512_mul_ps(abs_den, t_min), t);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, t, _mm512_mul_ps(abs_den, best));
+            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, t, _mm512_mul_ps(abs_den, of(self.t)));
+            if hit == 0 {
+                continue;
+            }
+            // The pairs that may hit, in the order of the one-triangle passes for each ray (its
+            // triangles in slot order), each against the ray's best as those passes leave it,
+            // in scalar: the same IEEE operations as their lanes, so the same bits.
+            let mut raw = [[0f32; PACKET]; 4];
+            let mut best = [0f32; PACKET];
+            // SAFETY: each destination is 16 writable f32s; `storeu` has no alignment
+            // requirement.
+            unsafe {
+                for (row, x) in raw.iter_mut().zip([t, u, v, abs_den]) {
+                    _mm512_storeu_ps(row.as_mut_ptr(), x);
+                }
+                _mm512_storeu_ps(best.as_mut_ptr(), self.t);
+            }
+            let [t, u, v, abs_den] = raw;
             while hit != 0 {
                 let pair = hit.trailing_zeros() as usize;
                 hit &= hit - 1;
-                out[pair % 4] |= 1 << number[first as usize + pair / 4];
+                let l = number[first as usize + pair / 4] as usize;
+                if t[pair] <= abs_den[pair] * best[l] {
+                    let inv = 1.0 / abs_den[pair];
+                    best[l] = t[pair] * inv;
+                    let m = 1u16 << l;
+                    self.t = _mm512_mask_mov_ps(self.t, m, _mm512_set1_ps(best[l]));
+                    self.u = _mm512_mask_mov_ps(self.u, m, _mm512_set1_ps(u[pair] * inv));
+                    self.v = _mm512_mask_mov_ps(self.v, m, _mm512_set1_ps(v[pair] * inv));
+                    let id = _mm512_set1_epi32(tri4.ids[pair % 4] as i32);
+                    self.prim = _mm512_mask_mov_epi32(self.prim, m, id);
+                }
             }
         }
-        out
     }
 }
 
@@ -374,19 +393,19 @@ mod tests {
     use crate::rng::SplitMix64;
     use crate::{MollerTriangle, Triangle, Vec3};
 
-    /// The any-hit test, which screens (triangle, ray) pairs when few lanes are active, leaves
-    /// every lane's best exactly as the unscreened test does: hit, `t`, `u` and `v` bit for bit
-    /// and the same triangle on ties (a triangle repeated in a later slot), over random
-    /// `Tri4`s with one to four triangles met one after another, windows that earlier hits
-    /// shrink, and active sets of every size.
+    /// The pair test that [`Best::test_tri4`] takes when few lanes are active leaves every
+    /// lane's best exactly as the one-triangle passes do: hit, `t`, `u` and `v` bit for bit and
+    /// the same triangle on ties (a triangle repeated in a later slot), over random `Tri4`s with
+    /// one to four triangles met one after another, windows that earlier hits shrink (within
+    /// a `Tri4` too), and active sets of every size.
     #[test]
-    fn screened_pairs_answer_as_every_triangle_on_every_lane() {
+    fn paired_lanes_answer_as_one_triangle_a_pass() {
         if Avx512Packets::detect().is_none() {
             eprintln!("no AVX-512F on this CPU: no packet is ever tested here");
             return;
         }
         let mut rng = SplitMix64::new(5);
-        let (mut screened, mut hits) = (0, 0);
+        let (mut paired, mut hits) = (0, 0);
         for case in 0..400 {
             let near = |rng: &mut SplitMix64| rng.point_in(Vec3::splat(-1.0), Vec3::splat(1.0));
             let tri4s: Vec<Tri4> = (0..3)
@@ -414,31 +433,28 @@ mod tests {
                 .collect();
             let block = &RayPackets::new(&rays).blocks[0];
             let active = (rng.next_u64() as u16) >> (case % 16);
-            let answers = |any_hit: bool| {
+            let answers = |whole: bool| {
                 // SAFETY: AVX-512F was detected above.
                 unsafe {
                     let (p, mut best) = load(block);
                     for tri4 in &tri4s {
-                        if any_hit {
-                            best.test_tri4::<true>(tri4, &p, active);
+                        if whole {
+                            best.test_tri4(tri4, &p, active);
                         } else {
-                            best.test_tri4::<false>(tri4, &p, active);
+                            best.each_triangle(tri4, &normals(tri4), &p, active);
                         }
                     }
                     best.hits()
                         .map(|(prim, h)| (prim, [h.t, h.u, h.v].map(f32::to_bits)))
                 }
             };
-            let (plain, paired) = (answers(false), answers(true));
-            assert_eq!(plain, paired, "case {case}, lanes {active:016b}");
-            screened += (active.count_ones() <= PAIRED_RAYS) as usize;
+            let (plain, whole) = (answers(false), answers(true));
+            assert_eq!(plain, whole, "case {case}, lanes {active:016b}");
+            paired += (active.count_ones() <= PAIRED_RAYS) as usize;
             hits += plain.iter().filter(|(prim, _)| *prim != NO_PRIM).count();
         }
         // Enough of both kinds for the comparison to mean something.
-        assert!(
-            screened > 100 && hits > 150,
-            "screened {screened}, hits {hits}"
-        );
+        assert!(paired > 100 && hits > 150, "paired {paired}, hits {hits}");
     }
 
     /// The loader's inverse directions are `Ray::inv_dir`'s, bit for bit, with zeros of both

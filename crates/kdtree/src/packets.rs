@@ -224,7 +224,7 @@ fn walk<const ANY_HIT: bool>(
         }
         let (first, count) = (node.first() as usize, node.count() as usize);
         for four in &kd.tri4s[first / LANES..(first + count).div_ceil(LANES)] {
-            best.test_tri4::<ANY_HIT>(four, p, lanes);
+            best.test_tri4(four, p, lanes);
         }
         if ANY_HIT {
             live &= !_mm512_mask_cmpneq_epi32_mask(lanes, best.prim, none);

@@ -248,7 +248,7 @@ fn walk<const W: usize>(
             let tri4s = (r.count as usize).div_ceil(4);
             usage.tri4s(tri4s as u32, lanes);
             for tri4 in &bvh.tri4s()[first..first + tri4s] {
-                best.test_tri4::<false>(tri4, p, lanes);
+                best.test_tri4(tri4, p, lanes);
             }
             farthest = _mm512_mask_reduce_max_ps(active, best.t);
         } else {
@@ -392,7 +392,7 @@ fn walk_any<const W: usize>(
             let tri4s = (r.count as usize).div_ceil(4);
             usage.tri4s(tri4s as u32, lanes);
             for tri4 in &bvh.tri4s()[first..first + tri4s] {
-                best.test_tri4::<true>(tri4, p, lanes);
+                best.test_tri4(tri4, p, lanes);
                 let hit = _mm512_mask_cmpneq_epi32_mask(lanes, best.prim, none);
                 if hit != 0 {
                     live &= !hit;
