@@ -258,7 +258,9 @@ impl Best {
 }
 
 /// Active rays up to which [`Best::test_tri4`] tests (triangle, ray) pairs: four rays against
-/// the four triangles fill the sixteen lanes of one pass (more rays would take a pass per four).
+/// the four triangles fill the sixteen lanes of one pass. Up to eight (two passes) was 2–6 %
+/// slower on camera rays (measured: see docs/experiments.md, "(triangle, ray) pairs tested in
+/// one pass").
 const PAIRED_RAYS: u32 = 4;
 
 impl Best {
