@@ -227,24 +227,9 @@ impl Best {
                 break;
             }
             let at = |v: &[[f32; 4]; 3]| [0, 1, 2].map(|a| _mm512_set1_ps(v[a][lane]));
-            let (v0, e1, e2, ng) = (at(&tri4.v0), at(&tri4.e1), at(&tri4.e2), at(ng4));
-            let c = [0, 1, 2].map(|a| _mm512_sub_ps(v0[a], p.origin[a]));
-            let rr = cross(&c, &p.dir);
-            let den = dot(&ng, &p.dir);
-            let abs_den = _mm512_abs_ps(den);
-            let u = flip(dot(&rr, &e2), den);
-            let v = flip(dot(&rr, &e1), den);
-            let zero = _mm512_setzero_ps();
-            let mut hit = _mm512_mask_cmp_ps_mask::<_CMP_NEQ_UQ>(active, den, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, u, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, v, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, _mm512_add_ps(u, v), abs_den);
-            if hit == 0 {
-                continue;
-            }
-            let t = flip(dot(&ng, &c), den);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(hit, _mm512_mul_ps(abs_den, p.t_min), t);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, t, _mm512_mul_ps(abs_den, self.t));
+            let tri = [at(&tri4.v0), at(&tri4.e1), at(&tri4.e2), at(ng4)];
+            let ray = (&p.origin, &p.dir, p.t_min, self.t);
+            let (hit, [t, u, v, abs_den]) = moller(&tri, ray, active);
             if hit == 0 {
                 continue;
             }
@@ -283,11 +268,10 @@ impl Best {
             // SAFETY: each row is four initialised f32s; `loadu` has no alignment requirement.
             [0, 1, 2].map(|a| _mm512_broadcast_f32x4(unsafe { _mm_loadu_ps(v[a].as_ptr()) }))
         };
-        let (v0, e1, e2, ng) = (four(&tri4.v0), four(&tri4.e1), four(&tri4.e2), four(ng4));
+        let tri = [four(&tri4.v0), four(&tri4.e1), four(&tri4.e2), four(ng4)];
         let slots = tri4.ids.iter().take_while(|&&id| id != NO_PRIM).count();
         let triangles = ((1u32 << slots) - 1) * 0x1111;
         let ray_of = _mm512_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3);
-        let zero = _mm512_setzero_ps();
         for pass in 0..rays.div_ceil(4) {
             let first = 4 * pass;
             let which = _mm512_add_epi32(ray_of, _mm512_set1_epi32(first as i32));
@@ -296,23 +280,7 @@ impl Best {
             let (origin, dir) = (p.origin.map(of), p.dir.map(of));
             let in_pass = (rays - first).min(4);
             let pairs = (((1u32 << (4 * in_pass)) - 1) & triangles) as u16;
-            let c = [0, 1, 2].map(|a| _mm512_sub_ps(v0[a], origin[a]));
-            let rr = cross(&c, &dir);
-            let den = dot(&ng, &dir);
-            let abs_den = _mm512_abs_ps(den);
-            let u = flip(dot(&rr, &e2), den);
-            let v = flip(dot(&rr, &e1), den);
-            let mut hit = _mm512_mask_cmp_ps_mask::<_CMP_NEQ_UQ>(pairs, den, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, u, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, v, zero);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, _mm512_add_ps(u, v), abs_den);
-            if hit == 0 {
-                continue;
-            }
-            let t = flip(dot(&ng, &c), den);
-            let t_min = of(p.t_min);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(hit, _mm512_mul_ps(abs_den, t_min), t);
-            hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, t, _mm512_mul_ps(abs_den, of(self.t)));
+            let (mut hit, quad) = moller(&tri, (&origin, &dir, of(p.t_min), of(self.t)), pairs);
             if hit == 0 {
                 continue;
             }
@@ -324,7 +292,7 @@ impl Best {
             // SAFETY: each destination is 16 writable f32s; `storeu` has no alignment
             // requirement.
             unsafe {
-                for (row, x) in raw.iter_mut().zip([t, u, v, abs_den]) {
+                for (row, x) in raw.iter_mut().zip(quad) {
                     _mm512_storeu_ps(row.as_mut_ptr(), x);
                 }
                 _mm512_storeu_ps(best.as_mut_ptr(), self.t);
@@ -347,6 +315,39 @@ impl Best {
             }
         }
     }
+}
+
+/// The Möller–Trumbore test of [`Tri4::test`], lane for lane: triangles `tri` (`v0`, `e1`,
+/// `e2` and the normal `e2 × e1`, per axis) against rays `(origin, dir, t_min, best)` in the
+/// lanes `lanes`. Returns the lanes that hit with `t_min < t <= best`, and `t`, `u`, `v` (each
+/// still times `|den|`) and `|den|`; no lane when the edge tests leave none, with the values
+/// then unset. Both passes of [`Best::test_tri4`] run it, so their bits agree.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn moller(
+    tri: &[[__m512; 3]; 4],
+    (origin, dir, t_min, best): (&[__m512; 3], &[__m512; 3], __m512, __m512),
+    lanes: u16,
+) -> (u16, [__m512; 4]) {
+    let [v0, e1, e2, ng] = tri;
+    let zero = _mm512_setzero_ps();
+    let c = [0, 1, 2].map(|a| _mm512_sub_ps(v0[a], origin[a]));
+    let rr = cross(&c, dir);
+    let den = dot(ng, dir);
+    let abs_den = _mm512_abs_ps(den);
+    let u = flip(dot(&rr, e2), den);
+    let v = flip(dot(&rr, e1), den);
+    let mut hit = _mm512_mask_cmp_ps_mask::<_CMP_NEQ_UQ>(lanes, den, zero);
+    hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, u, zero);
+    hit = _mm512_mask_cmp_ps_mask::<_CMP_GE_OQ>(hit, v, zero);
+    hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, _mm512_add_ps(u, v), abs_den);
+    if hit == 0 {
+        return (0, [zero; 4]);
+    }
+    let t = flip(dot(ng, &c), den);
+    hit = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(hit, _mm512_mul_ps(abs_den, t_min), t);
+    hit = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(hit, t, _mm512_mul_ps(abs_den, best));
+    (hit, [t, u, v, abs_den])
 }
 
 /// `a × b` lane-wise in glam's order, as [`Tri4::test`].
