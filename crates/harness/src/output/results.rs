@@ -54,22 +54,17 @@ pub struct SceneRatios {
 
 /// Every structure of the run but the reference, in the run's order, with its ratios.
 pub fn scene_ratios(report: &Report) -> Vec<SceneRatios> {
-    scene_ratios_to(report, &report.run.reference)
-}
-
-/// Every structure of the run but `reference`, with its ratios to `reference`'s medians on
-/// each scene (the run's reference, or another structure of the same run such as embree-high:
-/// the ratios are as fair, from the same run).
-pub fn scene_ratios_to(report: &Report, reference: &str) -> Vec<SceneRatios> {
-    scene_ratios_to_best(report, &[reference])
+    scene_ratios_to(report, &[&report.run.reference])
 }
 
 /// Every structure of the run but those of `group`, with its ratios, on each scene, to the
 /// best of `group` there: per workload the highest median throughput among them, the shortest
-/// median build and the smallest memory (a group of one is [`scene_ratios_to`]). So an entry
-/// races, scene by scene, whichever of several ways of calling one library is faster there,
-/// as Embree's stream and 16-ray packet calls are for coherent rays.
-pub fn scene_ratios_to_best(report: &Report, group: &[&str]) -> Vec<SceneRatios> {
+/// median build and the smallest memory. A group of one is one structure's medians: the run's
+/// reference, or another structure of the same run such as embree-high (as fair, from the same
+/// run). A larger group races an entry, scene by scene, against whichever of several ways of
+/// calling one library is faster there, as Embree's stream and 16-ray packet calls are for
+/// coherent rays.
+pub fn scene_ratios_to(report: &Report, group: &[&str]) -> Vec<SceneRatios> {
     let group_on = |scene: &str| -> Vec<&ResultEntry> {
         report
             .results
@@ -140,18 +135,13 @@ pub fn scene_ratios_to_best(report: &Report, group: &[&str]) -> Vec<SceneRatios>
 
 /// The headline rows: every structure of the run but the reference, in the run's order.
 pub fn headline_rows(report: &Report) -> Vec<HeadlineRow> {
-    headline_rows_to(report, &report.run.reference)
+    headline_rows_to(report, &[&report.run.reference])
 }
 
-/// [`headline_rows`] relative to `reference`, another structure of the same run.
-pub fn headline_rows_to(report: &Report, reference: &str) -> Vec<HeadlineRow> {
-    headline_rows_to_best(report, &[reference])
-}
-
-/// [`headline_rows`] relative to the best of `group` on each scene ([`scene_ratios_to_best`]).
-pub fn headline_rows_to_best(report: &Report, group: &[&str]) -> Vec<HeadlineRow> {
+/// [`headline_rows`] relative to the best of `group` on each scene ([`scene_ratios_to`]).
+pub fn headline_rows_to(report: &Report, group: &[&str]) -> Vec<HeadlineRow> {
     let mean = |v: &[(f64, String)]| geometric_mean(v.iter().map(|(x, _)| *x));
-    scene_ratios_to_best(report, group)
+    scene_ratios_to(report, group)
         .into_iter()
         .map(|r| HeadlineRow {
             workloads: r.workloads.iter().map(|w| mean(w)).collect(),
@@ -229,7 +219,7 @@ fn headline_table(report: &Report, group: &[&str]) -> String {
     s.push_str(" build | memory |\n|---|");
     s.push_str(&"---:|".repeat(workloads.len() + 2));
     s.push('\n');
-    let rows = headline_rows_to_best(report, group);
+    let rows = headline_rows_to(report, group);
     let mut peers_heading = PeersHeading::default();
     for row in &rows {
         peers_heading.before(&mut s, &row.structure, workloads.len() + 2);
@@ -299,7 +289,7 @@ fn agreement_line(report: &Report) -> String {
 /// The whole page; `report_link` is where the heading's link to the report points, and
 /// `also_against` names other structures of the run the headline is repeated against (say
 /// embree-high beside the reference embree-medium), each one structure or a group joined by
-/// [`GROUP_JOIN`] (the best of them on each scene: [`scene_ratios_to_best`]).
+/// [`GROUP_JOIN`] (the best of them on each scene: [`scene_ratios_to`]).
 pub fn results_page(report: &Report, report_link: &str, also_against: &[String]) -> String {
     let env = &report.header.environment;
     let run = &report.run;
