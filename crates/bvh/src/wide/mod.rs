@@ -43,6 +43,8 @@ mod node;
 mod optimal;
 mod pack;
 #[cfg(target_arch = "x86_64")]
+mod packet_node;
+#[cfg(target_arch = "x86_64")]
 mod packets;
 mod params;
 mod quantized;

@@ -14,10 +14,14 @@
 //! As there, bounds over the whole packet (`frustum.rs`) first rule out, in one pass over the
 //! node's planes, the children no ray can enter, so only the others are tested ray by ray: 5–20 %
 //! faster on camera rays (measured: see docs/experiments.md, "packet bounds before the per-ray box
-//! tests"). The trade-off, measured over the default suite's primary rays (docs/results/):
-//! 1.5–2.8× the single-ray walk on scenes of large triangles (Sponza, the teapots, Sibenik),
-//! little or less where triangles are smaller than the rays' spacing (the stadium from afar, San
-//! Francisco).
+//! tests"). Where a few lanes reach a node that leaves more children than lanes, the test is
+//! turned around (`packet_node.rs`): each lane against all the node's children in one pass, as
+//! the single-ray walk tests a node, with the same arithmetic, so the same children are entered:
+//! 1–4 % faster on camera and shadow rays (docs/experiments.md, "a node reached by few lanes
+//! tested lane by lane"). The trade-off, measured over the default suite's primary rays
+//! (docs/results/): 1.5–2.8× the single-ray walk on scenes of large triangles (Sponza, the
+//! teapots, Sibenik), little or less where triangles are smaller than the rays' spacing (the
+//! stadium from afar, San Francisco).
 //! Handing sparse subtrees or leaves back to the single-ray walk, as Embree's hybrid traversal
 //! does, did not measurably help (docs/experiments.md, "Packets for coherent rays"); handing
 //! whole packets over does, where the rays share little ([`Switch`], the `packet_floors` knob):
@@ -48,6 +52,7 @@
 
 use super::avx2;
 use super::frustum::Frustum;
+use super::packet_node::{children_by_lane, lanes_entering};
 use super::walk::with_stack;
 use crate::node::ChildRef;
 use crate::wide::{BvhWide, STACK};
@@ -256,6 +261,21 @@ fn walk<const W: usize>(
             let n = &bvh.nodes()[r.index as usize];
             let base = sp;
             let mut maybe = frustum.maybe_entered(n, farthest);
+            if few_lanes(lanes, maybe) {
+                let (mut entered, lanes_of, entry_of) =
+                    children_by_lane(p, n, near, lanes, maybe, best.t);
+                while entered != 0 {
+                    let slot = entered.trailing_zeros() as usize;
+                    entered &= entered - 1;
+                    let e = Entry {
+                        r: n.child[slot],
+                        t_entry: entry_of[slot],
+                        lanes: lanes_of[slot] as u16,
+                    };
+                    push_sorted(stack, base, &mut sp, e);
+                }
+                maybe = 0;
+            }
             while maybe != 0 {
                 let slot = maybe.trailing_zeros() as usize;
                 maybe &= maybe - 1;
@@ -263,15 +283,7 @@ fn walk<const W: usize>(
                 if child == ChildRef::default() {
                     break;
                 }
-                let mut t0 = p.t_min;
-                let mut t1 = best.t;
-                for (a, &near) in near.iter().enumerate() {
-                    let lo = _mm512_set1_ps(n.planes[a][near][slot]);
-                    let hi = _mm512_set1_ps(n.planes[a][1 - near][slot]);
-                    t0 = _mm512_max_ps(_mm512_mul_ps(_mm512_sub_ps(lo, p.origin[a]), p.inv[a]), t0);
-                    t1 = _mm512_min_ps(_mm512_mul_ps(_mm512_sub_ps(hi, p.origin[a]), p.inv[a]), t1);
-                }
-                let entered = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(lanes, t0, t1);
+                let (entered, t0) = lanes_entering(p, n, near, lanes, slot, best.t);
                 if entered != 0 {
                     let e = Entry {
                         r: child,
@@ -299,6 +311,21 @@ fn walk<const W: usize>(
             }
         }
     }
+}
+
+/// Lanes at most this many that reach a node test its children lane by lane
+/// ([`children_by_lane`]) where the packet bounds leave more children than that (2 and 8
+/// measured within the noise of 4: docs/experiments.md, "a node reached by few lanes tested
+/// lane by lane").
+const FEW_LANES: u32 = 4;
+
+/// Whether the `lanes` reaching a node test its children lane by lane rather than child by
+/// child, `maybe` being the children the packet bounds leave: one pass a lane against one a
+/// child, whichever are fewer.
+#[inline(always)]
+fn few_lanes(lanes: u16, maybe: u32) -> bool {
+    let n = lanes.count_ones();
+    n <= FEW_LANES && n < maybe.count_ones()
 }
 
 /// Pushes `e` onto `stack[base..*sp]`, kept in decreasing entry distance so the nearest is on
@@ -410,6 +437,20 @@ fn walk_any<const W: usize>(
             let n = &bvh.nodes()[r.index as usize];
             let base = sp;
             let mut maybe = frustum.maybe_entered(n, farthest);
+            if few_lanes(lanes, maybe) {
+                let (mut entered, lanes_of, _) = children_by_lane(p, n, near, lanes, maybe, t_max);
+                while entered != 0 {
+                    let slot = entered.trailing_zeros() as usize;
+                    entered &= entered - 1;
+                    stack[sp] = Entry {
+                        r: n.child[slot],
+                        t_entry: 0.0,
+                        lanes: lanes_of[slot] as u16,
+                    };
+                    sp += 1;
+                }
+                maybe = 0;
+            }
             while maybe != 0 {
                 let slot = maybe.trailing_zeros() as usize;
                 maybe &= maybe - 1;
@@ -417,15 +458,7 @@ fn walk_any<const W: usize>(
                 if child == ChildRef::default() {
                     break;
                 }
-                let mut t0 = p.t_min;
-                let mut t1 = t_max;
-                for (a, &near) in near.iter().enumerate() {
-                    let lo = _mm512_set1_ps(n.planes[a][near][slot]);
-                    let hi = _mm512_set1_ps(n.planes[a][1 - near][slot]);
-                    t0 = _mm512_max_ps(_mm512_mul_ps(_mm512_sub_ps(lo, p.origin[a]), p.inv[a]), t0);
-                    t1 = _mm512_min_ps(_mm512_mul_ps(_mm512_sub_ps(hi, p.origin[a]), p.inv[a]), t1);
-                }
-                let entered = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(lanes, t0, t1);
+                let (entered, _) = lanes_entering(p, n, near, lanes, slot, t_max);
                 if entered != 0 {
                     stack[sp] = Entry {
                         r: child,
