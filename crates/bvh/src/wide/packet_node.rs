@@ -41,8 +41,8 @@ pub(super) fn lanes_entering<const W: usize>(
 
 /// The children of `n` among `slots` that the `lanes` of `p` enter with their far ends at
 /// `t_far` (a lane each): as a slot mask, and per slot the lanes that enter it and the least of
-/// their entry distances (meaningful only for the slots in the mask). Unused slots hold an
-/// empty box, which no lane enters.
+/// their entry distances (meaningful only for the slots in the mask). Slots not in use are
+/// never in the mask.
 #[target_feature(enable = "avx512f")]
 #[inline]
 pub(super) fn children_by_lane<const W: usize>(
@@ -61,6 +61,14 @@ pub(super) fn children_by_lane<const W: usize>(
     };
     let lo = [0, 1, 2].map(|a| row(&n.planes[a][near[a]]));
     let hi = [0, 1, 2].map(|a| row(&n.planes[a][1 - near[a]]));
+    // The slots in use (an unused one holds an empty box, minimum above maximum), so that no
+    // slot the child-by-child walk stops before is ever reported, whatever a ray's direction.
+    let (min, max) = if near[0] == 0 {
+        (lo[0], hi[0])
+    } else {
+        (hi[0], lo[0])
+    };
+    let slots = slots as u16 & _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(used, min, max);
     let mut entry = _mm512_set1_ps(f32::INFINITY);
     let mut by_slot = _mm512_setzero_si512();
     let mut union = 0u16;
@@ -77,7 +85,7 @@ pub(super) fn children_by_lane<const W: usize>(
             t0 = _mm512_max_ps(_mm512_mul_ps(_mm512_sub_ps(lo[a], origin), inv), t0);
             t1 = _mm512_min_ps(_mm512_mul_ps(_mm512_sub_ps(hi[a], origin), inv), t1);
         }
-        let entered = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(slots as u16, t0, t1);
+        let entered = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(slots, t0, t1);
         entry = _mm512_mask_min_ps(entry, entered, entry, t0);
         by_slot = _mm512_mask_or_epi32(by_slot, entered, by_slot, _mm512_set1_epi32(1 << lane));
         union |= entered;
@@ -173,6 +181,7 @@ mod tests {
                         let slots = rng.next_u64() as u32 | 0xF;
                         let (union, lanes_of, entry_of) =
                             children_by_lane(&p, &n, near, lanes, slots, best.t);
+                        assert_eq!(union >> n.children(), 0, "a slot not in use");
                         for slot in 0..W {
                             let (want, t) = if slots >> slot & 1 == 1 {
                                 let (e, t0) = lanes_entering(&p, &n, near, lanes, slot, best.t);

@@ -17,8 +17,8 @@
 //! tests"). Where a few lanes reach a node that leaves more children than lanes, the test is
 //! turned around (`packet_node.rs`): each lane against all the node's children in one pass, as
 //! the single-ray walk tests a node, with the same arithmetic, so the same children are entered:
-//! 1–4 % faster on camera and shadow rays (docs/experiments.md, "a node reached by few lanes
-//! tested lane by lane"). The trade-off, measured over the default suite's primary rays
+//! about 2 % faster on camera rays, shadow rays within the noise (docs/experiments.md, "a node
+//! reached by few lanes tested lane by lane"). The trade-off, measured over the default suite's primary rays
 //! (docs/results/): 1.5–2.8× the single-ray walk on scenes of large triangles (Sponza, the
 //! teapots, Sibenik), little or less where triangles are smaller than the rays' spacing (the
 //! stadium from afar, San Francisco).
