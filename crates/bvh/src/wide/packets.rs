@@ -18,10 +18,10 @@
 //! turned around (`packet_node.rs`): each lane against all the node's children in one pass, as
 //! the single-ray walk tests a node, with the same arithmetic, so the same children are entered:
 //! about 2 % faster on camera rays, shadow rays within the noise (docs/experiments.md, "a node
-//! reached by few lanes tested lane by lane"). The trade-off, measured over the default suite's primary rays
-//! (docs/results/): 1.5–2.8× the single-ray walk on scenes of large triangles (Sponza, the
-//! teapots, Sibenik), little or less where triangles are smaller than the rays' spacing (the
-//! stadium from afar, San Francisco).
+//! reached by few lanes tested lane by lane"). The trade-off, measured over the default suite's
+//! primary rays (docs/results/): 1.5–2.8× the single-ray walk on scenes of large triangles
+//! (Sponza, the teapots, Sibenik), little or less where triangles are smaller than the rays'
+//! spacing (the stadium from afar, San Francisco).
 //! Handing sparse subtrees or leaves back to the single-ray walk, as Embree's hybrid traversal
 //! does, did not measurably help (docs/experiments.md, "Packets for coherent rays"); handing
 //! whole packets over does, where the rays share little ([`Switch`], the `packet_floors` knob):
@@ -274,23 +274,23 @@ fn walk<const W: usize>(
                     };
                     push_sorted(stack, base, &mut sp, e);
                 }
-                maybe = 0;
-            }
-            while maybe != 0 {
-                let slot = maybe.trailing_zeros() as usize;
-                maybe &= maybe - 1;
-                let child = n.child[slot];
-                if child == ChildRef::default() {
-                    break;
-                }
-                let (entered, t0) = lanes_entering(p, n, near, lanes, slot, best.t);
-                if entered != 0 {
-                    let e = Entry {
-                        r: child,
-                        t_entry: _mm512_mask_reduce_min_ps(entered, t0),
-                        lanes: entered,
-                    };
-                    push_sorted(stack, base, &mut sp, e);
+            } else {
+                while maybe != 0 {
+                    let slot = maybe.trailing_zeros() as usize;
+                    maybe &= maybe - 1;
+                    let child = n.child[slot];
+                    if child == ChildRef::default() {
+                        break;
+                    }
+                    let (entered, t0) = lanes_entering(p, n, near, lanes, slot, best.t);
+                    if entered != 0 {
+                        let e = Entry {
+                            r: child,
+                            t_entry: _mm512_mask_reduce_min_ps(entered, t0),
+                            lanes: entered,
+                        };
+                        push_sorted(stack, base, &mut sp, e);
+                    }
                 }
             }
             if sp > base {
@@ -449,23 +449,23 @@ fn walk_any<const W: usize>(
                     };
                     sp += 1;
                 }
-                maybe = 0;
-            }
-            while maybe != 0 {
-                let slot = maybe.trailing_zeros() as usize;
-                maybe &= maybe - 1;
-                let child = n.child[slot];
-                if child == ChildRef::default() {
-                    break;
-                }
-                let (entered, _) = lanes_entering(p, n, near, lanes, slot, t_max);
-                if entered != 0 {
-                    stack[sp] = Entry {
-                        r: child,
-                        t_entry: 0.0,
-                        lanes: entered,
-                    };
-                    sp += 1;
+            } else {
+                while maybe != 0 {
+                    let slot = maybe.trailing_zeros() as usize;
+                    maybe &= maybe - 1;
+                    let child = n.child[slot];
+                    if child == ChildRef::default() {
+                        break;
+                    }
+                    let (entered, _) = lanes_entering(p, n, near, lanes, slot, t_max);
+                    if entered != 0 {
+                        stack[sp] = Entry {
+                            r: child,
+                            t_entry: 0.0,
+                            lanes: entered,
+                        };
+                        sp += 1;
+                    }
                 }
             }
             // The lowest slot first, as the single-ray any-hit walk.
