@@ -52,6 +52,7 @@
 
 use super::avx2;
 use super::frustum::Frustum;
+use super::node::WideNode;
 use super::packet_node::{children_by_lane, lanes_entering};
 use super::walk::with_stack;
 use crate::node::ChildRef;
@@ -260,39 +261,10 @@ fn walk<const W: usize>(
             usage.node(lanes);
             let n = &bvh.nodes()[r.index as usize];
             let base = sp;
-            let mut maybe = frustum.maybe_entered(n, farthest);
-            if few_lanes(lanes, maybe) {
-                let (mut entered, lanes_of, entry_of) =
-                    children_by_lane(p, n, near, lanes, maybe, best.t);
-                while entered != 0 {
-                    let slot = entered.trailing_zeros() as usize;
-                    entered &= entered - 1;
-                    let e = Entry {
-                        r: n.child[slot],
-                        t_entry: entry_of[slot],
-                        lanes: lanes_of[slot] as u16,
-                    };
-                    push_sorted(stack, base, &mut sp, e);
-                }
-            } else {
-                while maybe != 0 {
-                    let slot = maybe.trailing_zeros() as usize;
-                    maybe &= maybe - 1;
-                    let child = n.child[slot];
-                    if child == ChildRef::default() {
-                        break;
-                    }
-                    let (entered, t0) = lanes_entering(p, n, near, lanes, slot, best.t);
-                    if entered != 0 {
-                        let e = Entry {
-                            r: child,
-                            t_entry: _mm512_mask_reduce_min_ps(entered, t0),
-                            lanes: entered,
-                        };
-                        push_sorted(stack, base, &mut sp, e);
-                    }
-                }
-            }
+            let maybe = frustum.maybe_entered(n, farthest);
+            each_entered::<W, true>(p, n, near, lanes, maybe, best.t, |e| {
+                push_sorted(stack, base, &mut sp, e);
+            });
             if sp > base {
                 sp -= 1;
                 (r, lanes) = (stack[sp].r, stack[sp].lanes);
@@ -326,6 +298,58 @@ const FEW_LANES: u32 = 4;
 fn few_lanes(lanes: u16, maybe: u32) -> bool {
     let n = lanes.count_ones();
     n <= FEW_LANES && n < maybe.count_ones()
+}
+
+/// Calls `push` with every child of `n` among `maybe` (the children the packet bounds leave)
+/// that some of the `lanes` of `p` enter with their far ends at `t_far`, in slot order, as an
+/// entry carrying the lanes that enter it and, with `DISTANCE`, the least of their entry
+/// distances (else 0: the any-hit walk never compares them). The node is tested lane by lane
+/// where [`few_lanes`] says so, else child by child up to the first unused slot; either way
+/// each lane enters the same children.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn each_entered<const W: usize, const DISTANCE: bool>(
+    p: &Packet,
+    n: &WideNode<W>,
+    near: [usize; 3],
+    lanes: u16,
+    mut maybe: u32,
+    t_far: __m512,
+    mut push: impl FnMut(Entry),
+) {
+    if few_lanes(lanes, maybe) {
+        let (mut entered, lanes_of, entry_of) = children_by_lane(p, n, near, lanes, maybe, t_far);
+        while entered != 0 {
+            let slot = entered.trailing_zeros() as usize;
+            entered &= entered - 1;
+            push(Entry {
+                r: n.child[slot],
+                t_entry: if DISTANCE { entry_of[slot] } else { 0.0 },
+                lanes: lanes_of[slot] as u16,
+            });
+        }
+        return;
+    }
+    while maybe != 0 {
+        let slot = maybe.trailing_zeros() as usize;
+        maybe &= maybe - 1;
+        let child = n.child[slot];
+        if child == ChildRef::default() {
+            break;
+        }
+        let (entered, t0) = lanes_entering(p, n, near, lanes, slot, t_far);
+        if entered != 0 {
+            push(Entry {
+                r: child,
+                t_entry: if DISTANCE {
+                    _mm512_mask_reduce_min_ps(entered, t0)
+                } else {
+                    0.0
+                },
+                lanes: entered,
+            });
+        }
+    }
 }
 
 /// Pushes `e` onto `stack[base..*sp]`, kept in decreasing entry distance so the nearest is on
@@ -436,38 +460,11 @@ fn walk_any<const W: usize>(
             usage.node(lanes);
             let n = &bvh.nodes()[r.index as usize];
             let base = sp;
-            let mut maybe = frustum.maybe_entered(n, farthest);
-            if few_lanes(lanes, maybe) {
-                let (mut entered, lanes_of, _) = children_by_lane(p, n, near, lanes, maybe, t_max);
-                while entered != 0 {
-                    let slot = entered.trailing_zeros() as usize;
-                    entered &= entered - 1;
-                    stack[sp] = Entry {
-                        r: n.child[slot],
-                        t_entry: 0.0,
-                        lanes: lanes_of[slot] as u16,
-                    };
-                    sp += 1;
-                }
-            } else {
-                while maybe != 0 {
-                    let slot = maybe.trailing_zeros() as usize;
-                    maybe &= maybe - 1;
-                    let child = n.child[slot];
-                    if child == ChildRef::default() {
-                        break;
-                    }
-                    let (entered, _) = lanes_entering(p, n, near, lanes, slot, t_max);
-                    if entered != 0 {
-                        stack[sp] = Entry {
-                            r: child,
-                            t_entry: 0.0,
-                            lanes: entered,
-                        };
-                        sp += 1;
-                    }
-                }
-            }
+            let maybe = frustum.maybe_entered(n, farthest);
+            each_entered::<W, false>(p, n, near, lanes, maybe, t_max, |e| {
+                stack[sp] = e;
+                sp += 1;
+            });
             // The lowest slot first, as the single-ray any-hit walk.
             stack[base..sp].reverse();
         }
