@@ -19,6 +19,19 @@ fn down_from(x: f32, y: f32) -> Ray {
     Ray::infinite(Vec3::new(x, y, 1.0), Vec3::new(0.0, 0.0, -1.0))
 }
 
+/// The float just below `t`.
+fn below(t: f32) -> f32 {
+    f32::from_bits(t.to_bits() - 1)
+}
+
+/// Whether Embree's reported distance is the crossing at exactly 1 of these tests' rays. Embree
+/// reports `t` as the crossing times an estimate of a reciprocal: its AVX-512 kernels land on
+/// 1.0, its AVX2 kernels (one refinement of a 12-bit estimate) one ulp short
+/// (docs/validation.md, E4).
+fn at_one(t: f32) -> bool {
+    t == 1.0 || t == below(1.0)
+}
+
 #[test]
 fn empty_mesh_builds_and_every_ray_misses() {
     let (mesh, _) = TriangleMesh::new(vec![], vec![]).unwrap();
@@ -42,7 +55,7 @@ fn one_triangle_hit_has_embree_barycentrics() {
         let hit = embree
             .intersect(&down_from(0.25, 0.5))
             .expect("inside the triangle");
-        assert_eq!((hit.t, hit.prim), (1.0, 0), "{}", embree.name());
+        assert!(at_one(hit.t) && hit.prim == 0, "{}: {hit:?}", embree.name());
         // p = (1-u-v) v0 + u v1 + v v2 = (u, v, 0)
         assert!(
             (hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.5).abs() < 1e-6,
@@ -74,7 +87,10 @@ fn axis_parallel_rays_with_signed_zeros_hit_a_flat_scene() {
                     let origin = Vec3::new(0.2, 0.3, -dz);
                     let ray = Ray::infinite(origin, Vec3::new(dx, dy, dz));
                     let hit = embree.intersect(&ray);
-                    assert_eq!(hit.map(|h| (h.t, h.prim)), Some((1.0, 0)), "{ray:?}");
+                    assert!(
+                        hit.is_some_and(|h| at_one(h.t) && h.prim == 0),
+                        "{ray:?}: {hit:?}"
+                    );
                     assert!(embree.occluded(&ray), "{ray:?}");
                 }
             }
@@ -85,49 +101,58 @@ fn axis_parallel_rays_with_signed_zeros_hit_a_flat_scene() {
     }
 }
 
-/// Hit when t_min < t <= t_max: exactly at t_max is a hit in every preset.
+/// Exactly at t_max is a hit in every preset, one ulp short a miss. Fast mode holds the exact
+/// crossing (1 here) to `t <= t_max`, robust mode the `t` it reports, which Embree's AVX2
+/// kernels put one ulp short of the crossing (docs/validation.md, E4): each preset is held to
+/// its own end.
 #[test]
 fn hit_exactly_at_t_max_is_a_hit() {
-    let ray = Ray::new(
-        Vec3::new(0.25, 0.25, 1.0),
-        Vec3::new(0.0, 0.0, -1.0),
-        0.0,
-        1.0,
-    );
-    let short = ray.with_t_max(f32::from_bits(1.0f32.to_bits() - 1));
+    let down = Ray::infinite(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0));
     for params in presets() {
         let embree = EmbreeScene::build(one_triangle(), &params).unwrap();
+        let reported = embree.intersect(&down).expect("straight down onto it").t;
+        assert!(at_one(reported), "{}: {reported}", embree.name());
+        let end = if params.robust { reported } else { 1.0 };
+        let ray = down.with_t_max(end);
         assert_eq!(
             embree.intersect(&ray).map(|h| h.t),
-            Some(1.0),
-            "{}",
+            Some(reported),
+            "{} at t_max = {end}",
             embree.name()
         );
-        assert!(embree.occluded(&ray));
+        assert!(embree.occluded(&ray), "{}", embree.name());
+        let short = down.with_t_max(below(end));
         assert_eq!(
             embree.intersect(&short),
             None,
             "one ulp short: {}",
             embree.name()
         );
+        assert!(!embree.occluded(&short), "one ulp short: {}", embree.name());
     }
 }
 
 /// Pins the behaviour docs/validation.md, E4 records: exactly at t_min, fast mode misses
-/// (strict `t_min < t`) and robust mode hits (`t_min <= t`). If this changes, the comparison
-/// policy for robust mode must be revisited.
+/// (strict `t_min < t` on the exact crossing, 1 here) and robust mode hits (`t_min <= t` on the
+/// `t` it reports, one ulp short of the crossing with Embree's AVX2 kernels). If this changes,
+/// the comparison policy for robust mode must be revisited.
 #[test]
 fn hit_exactly_at_t_min_depends_on_robust_mode() {
-    let ray = Ray::new(
+    let down = Ray::new(
         Vec3::new(0.25, 0.25, 1.0),
         Vec3::new(0.0, 0.0, -1.0),
-        1.0,
+        0.0,
         2.0,
     );
     for params in presets() {
         let embree = EmbreeScene::build(one_triangle(), &params).unwrap();
+        let reported = embree.intersect(&down).expect("straight down onto it").t;
+        assert!(at_one(reported), "{}: {reported}", embree.name());
+        let start = if params.robust { reported } else { 1.0 };
+        let ray = Ray::new(down.origin(), down.dir(), start, 2.0);
         let hit = embree.intersect(&ray).is_some();
-        assert_eq!(hit, params.robust, "{}", embree.name());
+        assert_eq!(hit, params.robust, "{} at t_min = {start}", embree.name());
+        assert_eq!(embree.occluded(&ray), params.robust, "{}", embree.name());
     }
 }
 
