@@ -358,7 +358,7 @@ fn a_schema_1_report_reads_through_the_old_names() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The committed CI baselines, one per CPU model (`reports/baseline/ci-<cpu>.json`).
+/// The committed CI baselines, one per CPU: model and ISA (`reports/baseline/ci-<cpu>.json`).
 fn ci_baselines() -> Vec<std::path::PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/baseline");
     let mut found: Vec<_> = std::fs::read_dir(&dir)

@@ -180,7 +180,7 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
         }
     }
     let comparable = environment_warnings(base, new, opts, &mut findings);
-    // Ratios to the reference do not carry between CPU models (docs/usage.md, `compare`).
+    // Ratios to the reference do not carry between CPUs (docs/usage.md, `compare`).
     let cross_cpu;
     let opts = if other_cpu(base, new) && !opts.timing_advisory {
         findings.push(Finding::about(
@@ -188,10 +188,11 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
             "",
             format!(
                 "timing slowdowns are advisory: the base was timed on `{}`, the new report on \
-                 `{}`, and a ratio to the reference does not carry between CPU models; \
-                 correctness and deterministic figures are gated as always. A baseline made on \
-                 this CPU (scripts/update-baseline) gates timing here",
-                base.header.environment.cpu_model, new.header.environment.cpu_model
+                 `{}`, and a ratio to the reference does not carry between CPUs; correctness \
+                 and deterministic figures are gated as always. A baseline made on this CPU \
+                 (scripts/update-baseline) gates timing here",
+                machine(&base.header.environment),
+                machine(&new.header.environment)
             ),
         ));
         cross_cpu = CompareOptions {
@@ -287,9 +288,23 @@ pub fn compare(base: &Report, new: &Report, opts: &CompareOptions) -> Comparison
     Comparison { rows, findings }
 }
 
-/// Whether the two reports were timed on different CPU models.
+/// Whether the two reports were timed on different CPUs: another model name, or another set of
+/// SIMD features. One model name (`AMD EPYC`) covers CPUs with and without AVX-512, and the
+/// kernels picked at run time differ between them (the packet walks need AVX-512, Embree picks
+/// its AVX2 or AVX-512 kernels), so a ratio to the reference does not carry from one to the
+/// other.
 pub fn other_cpu(base: &Report, new: &Report) -> bool {
-    base.header.environment.cpu_model != new.header.environment.cpu_model
+    let (b, n) = (&base.header.environment, &new.header.environment);
+    b.cpu_model != n.cpu_model || b.cpu_flags != n.cpu_flags
+}
+
+/// A CPU as the cross-CPU note names it: the model, with its SIMD features.
+fn machine(e: &crate::env::Environment) -> String {
+    if e.cpu_flags.is_empty() {
+        e.cpu_model.clone()
+    } else {
+        format!("{} ({})", e.cpu_model, e.cpu_flags.join(" "))
+    }
 }
 
 /// Warns about different machines and settings; returns whether deterministic figures are
@@ -303,6 +318,11 @@ fn environment_warnings(
     let (be, ne) = (&base.header.environment, &new.header.environment);
     let machine = [
         ("CPU", be.cpu_model.clone(), ne.cpu_model.clone()),
+        (
+            "SIMD features",
+            be.cpu_flags.join(" "),
+            ne.cpu_flags.join(" "),
+        ),
         ("cores", be.cores.to_string(), ne.cores.to_string()),
         ("threads", be.threads.to_string(), ne.threads.to_string()),
         (
