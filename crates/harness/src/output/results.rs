@@ -302,10 +302,22 @@ pub fn results_page(report: &Report, report_link: &str, also_against: &[String])
     } else {
         String::new()
     };
+    // One model name can cover CPUs with and without AVX-512, whose kernels differ: the
+    // features say which one the figures belong to.
+    let features = if env.cpu_flags.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; {}; Embree's {} kernels",
+            env.cpu_flags.join(" "),
+            env.embree.isa
+        )
+    };
     let _ = writeln!(
         s,
-        "Suite `{}`, {} thread(s), {} rays per ray workload{points}, seed {}, on {} ({} cores); \
-         every answer checked against `{}`. Report: [{report_link}]({report_link}).\n",
+        "Suite `{}`, {} thread(s), {} rays per ray workload{points}, seed {}, on {} ({} \
+         cores{features}); every answer checked against `{}`. Report: \
+         [{report_link}]({report_link}).\n",
         run.suite.as_deref().unwrap_or("none"),
         run.threads,
         run.rays,

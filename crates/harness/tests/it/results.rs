@@ -119,6 +119,19 @@ fn the_page_has_the_headline_scene_and_sah_tables_and_links_the_report() {
         "# Results of {} (revision {revision})",
         &report.header.environment.timestamp[..10]
     )));
+    // The CPU's SIMD features and Embree's kernels: one model name can cover CPUs with and
+    // without AVX-512.
+    let env = &report.header.environment;
+    if !env.cpu_flags.is_empty() {
+        let machine = format!(
+            "on {} ({} cores; {}; Embree's {} kernels)",
+            env.cpu_model,
+            env.cores,
+            env.cpu_flags.join(" "),
+            env.embree.isa
+        );
+        assert!(page.contains(&machine), "{machine}\n{page}");
+    }
 
     let headline = &page[page.find("## Headline").unwrap()..page.find("## Scenes").unwrap()];
     assert!(
