@@ -13,14 +13,16 @@
 //!   closest-point queries.
 //! * [`SplitMix64`]: the one small seeded generator of the workspace.
 //!
-//! No acceleration structures, and no `unsafe` outside the AVX-512 packet kernel (`packet`) and
-//! the cache hint (`prefetch`).
-#![deny(unsafe_code)] // allowed only in the AVX-512 packet kernel and the cache hint
+//! No acceleration structures, and no `unsafe` outside the packet kernels (`packet` for
+//! AVX-512, `packet8` for AVX2) and the cache hint (`prefetch`).
+#![deny(unsafe_code)] // allowed only in the packet kernels and the cache hint
 
 mod aabb;
 mod mesh;
 #[cfg(target_arch = "x86_64")]
 pub mod packet;
+#[cfg(target_arch = "x86_64")]
+pub mod packet8;
 mod point;
 mod prefetch;
 mod ray;

@@ -63,6 +63,13 @@ pub struct RayBlock {
     rows: [[f32; PACKET]; 8],
 }
 
+impl RayBlock {
+    /// The rows, for the 8-lane loader (`packet8`).
+    pub(crate) fn rows(&self) -> &[[f32; PACKET]; 8] {
+        &self.rows
+    }
+}
+
 /// A coherent batch as blocks of [`PACKET`] rays.
 #[derive(Clone, Debug)]
 pub struct RayPackets {
@@ -381,7 +388,7 @@ fn flip(x: __m512, by: __m512) -> __m512 {
 
 /// `e2 × e1` of a `Tri4`'s four triangles, per axis, in glam's order.
 #[inline(always)]
-fn normals(t: &Tri4) -> [[f32; 4]; 3] {
+pub(crate) fn normals(t: &Tri4) -> [[f32; 4]; 3] {
     let (e1, e2) = (&t.e1, &t.e2);
     [
         std::array::from_fn(|l| e2[1][l] * e1[2][l] - e1[1][l] * e2[2][l]),

@@ -235,7 +235,7 @@ fn own_structures() -> Vec<StructureEntry> {
         ),
         register::<Bvh8>(
             "bvh8-packets",
-            "the bvh8-binned tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane, but where a packet's walk shares few nodes and triangles among its rays, the next packets of its 256 rays ray by ray; every other batch ray by ray as bvh8-binned",
+            "the bvh8-binned tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane (two packets of eight AVX2 lanes on a CPU without AVX-512F), but where a packet's walk shares few nodes and triangles among its rays, the next packets of its 256 rays ray by ray; every other batch ray by ray as bvh8-binned",
             None,
             |_| WideParams {
                 coherent_packets: true,

@@ -2,7 +2,8 @@
 //! can enter in one pass (interval arithmetic over the packet, as in Wald, Boulos and Shirley
 //! 2007), before the packet walk tests the rest ray by ray: eight slots a pass for an 8-wide
 //! node, all sixteen of a 16-wide node in one 16-lane pass (the same operations lane for lane,
-//! so the same slots as two 8-lane passes).
+//! so the same slots as two 8-lane passes). The eight-lane packets of AVX2 ([`Frustum8`]) bound
+//! their rays the same way and take the 8-lane passes.
 //!
 //! Exactness: the bound never rules out a child that a ray's own slab test enters, so the
 //! packet walk tests, pushes and visits exactly what it would without it. Per axis, a ray's
@@ -16,6 +17,7 @@
 
 use super::node::WideNode;
 use raybench_geom::packet::Packet;
+use raybench_geom::packet8::{self, Packet8};
 use std::arch::x86_64::*;
 
 /// Bounds over a set of lanes of a packet whose directions lie in one octant.
@@ -90,41 +92,21 @@ impl Frustum {
         mask
     }
 
-    /// [`Frustum::maybe_entered`] for the slots `8 * o ..`.
+    /// [`Frustum::maybe_entered`] for the slots `8 * o ..`: [`Frustum8::octet`] on the low
+    /// halves (the bounds are the same in every lane).
     #[target_feature(enable = "avx512f")]
     #[inline]
     fn octet<const W: usize>(&self, n: &WideNode<W>, o: usize, t_max: f32) -> u32 {
-        // A NaN bound (`0 * inf`) is replaced by `fill`: no bound on that axis.
-        let bound = |x: __m256, y: __m256, nearest: bool| {
-            let nan = _mm256_cmp_ps::<_CMP_UNORD_Q>(x, y);
-            let (b, fill) = if nearest {
-                (_mm256_min_ps(x, y), f32::NEG_INFINITY)
-            } else {
-                (_mm256_max_ps(x, y), f32::INFINITY)
-            };
-            _mm256_blendv_ps(b, _mm256_set1_ps(fill), nan)
+        let low = |v: __m512| _mm512_castps512_ps256(v);
+        let eight = Frustum8 {
+            near_origin: self.near_origin.map(low),
+            far_origin: self.far_origin.map(low),
+            inv_lo: self.inv_lo.map(low),
+            inv_hi: self.inv_hi.map(low),
+            t_min: low(self.t_min),
+            near: self.near,
         };
-        let low = _mm512_castps512_ps256;
-        let mut t0 = low(self.t_min);
-        let mut t1 = _mm256_set1_ps(t_max);
-        for a in 0..3 {
-            let load = |side: usize| {
-                let row: &[f32; 8] = &n.planes[a][side].as_chunks::<8>().0[o];
-                // SAFETY: a reference to 8 initialised f32s; `loadu` has no alignment
-                // requirement.
-                unsafe { _mm256_loadu_ps(row.as_ptr()) }
-            };
-            let (inv_lo, inv_hi) = (low(self.inv_lo[a]), low(self.inv_hi[a]));
-            let d = _mm256_sub_ps(load(self.near[a]), low(self.near_origin[a]));
-            let entry = bound(_mm256_mul_ps(d, inv_lo), _mm256_mul_ps(d, inv_hi), true);
-            t0 = _mm256_max_ps(entry, t0);
-            let d = _mm256_sub_ps(load(1 - self.near[a]), low(self.far_origin[a]));
-            let exit = bound(_mm256_mul_ps(d, inv_lo), _mm256_mul_ps(d, inv_hi), false);
-            t1 = _mm256_min_ps(exit, t1);
-        }
-        // An empty slot (+inf minimum, -inf maximum) may pass where an inverse is zero; the
-        // walk stops at the first empty slot.
-        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+        eight.octet(n, o, t_max)
     }
 
     /// [`Frustum::maybe_entered`] for a 16-wide node, in one 16-lane pass: [`Frustum::octet`]'s
@@ -161,6 +143,99 @@ impl Frustum {
             t1 = _mm512_min_ps(exit, t1);
         }
         u32::from(_mm512_cmp_ps_mask::<_CMP_LE_OQ>(t0, t1))
+    }
+}
+
+/// [`Frustum`] over a set of lanes of an eight-lane packet ([`Packet8`], AVX2), each bound
+/// broadcast to eight lanes: one pass per eight slots.
+pub(super) struct Frustum8 {
+    near_origin: [__m256; 3],
+    far_origin: [__m256; 3],
+    inv_lo: [__m256; 3],
+    inv_hi: [__m256; 3],
+    t_min: __m256,
+    pub(super) near: [usize; 3],
+}
+
+impl Frustum8 {
+    /// The bounds of the `lanes` of `p` (not empty), whose directions lie in `octant`.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn new(p: &Packet8, lanes: u8, octant: u8) -> Frustum8 {
+        let near = [0, 1, 2].map(|a| (octant >> a & 1) as usize);
+        let splat = |x: f32| _mm256_set1_ps(x);
+        let lo = |v: __m256| packet8::reduce_min(lanes, v);
+        let hi = |v: __m256| packet8::reduce_max(lanes, v);
+        let down = |a: usize| near[a] == 1;
+        Frustum8 {
+            near_origin: [0, 1, 2].map(|a| {
+                splat(if down(a) {
+                    lo(p.origin[a])
+                } else {
+                    hi(p.origin[a])
+                })
+            }),
+            far_origin: [0, 1, 2].map(|a| {
+                splat(if down(a) {
+                    hi(p.origin[a])
+                } else {
+                    lo(p.origin[a])
+                })
+            }),
+            inv_lo: p.inv.map(|v| splat(lo(v))),
+            inv_hi: p.inv.map(|v| splat(hi(v))),
+            t_min: splat(lo(p.t_min)),
+            near,
+        }
+    }
+
+    /// The slots of `n` that some lane may enter with its far end at most `t_max`, as
+    /// [`Frustum::maybe_entered`], eight slots a pass; a 4-wide node has every slot set.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn maybe_entered<const W: usize>(&self, n: &WideNode<W>, t_max: f32) -> u32 {
+        if !W.is_multiple_of(8) {
+            return (1 << W) - 1;
+        }
+        let mut mask = 0;
+        for o in 0..W / 8 {
+            mask |= self.octet(n, o, t_max) << (8 * o);
+        }
+        mask
+    }
+
+    /// [`Frustum8::maybe_entered`] for the slots `8 * o ..`.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    fn octet<const W: usize>(&self, n: &WideNode<W>, o: usize, t_max: f32) -> u32 {
+        // A NaN bound (`0 * inf`) is replaced by `fill`: no bound on that axis.
+        let bound = |x: __m256, y: __m256, nearest: bool| {
+            let nan = _mm256_cmp_ps::<_CMP_UNORD_Q>(x, y);
+            let (b, fill) = if nearest {
+                (_mm256_min_ps(x, y), f32::NEG_INFINITY)
+            } else {
+                (_mm256_max_ps(x, y), f32::INFINITY)
+            };
+            _mm256_blendv_ps(b, _mm256_set1_ps(fill), nan)
+        };
+        let mut t0 = self.t_min;
+        let mut t1 = _mm256_set1_ps(t_max);
+        for a in 0..3 {
+            let load = |side: usize| {
+                let row: &[f32; 8] = &n.planes[a][side].as_chunks::<8>().0[o];
+                // SAFETY: a reference to 8 initialised f32s; `loadu` has no alignment
+                // requirement.
+                unsafe { _mm256_loadu_ps(row.as_ptr()) }
+            };
+            let (inv_lo, inv_hi) = (self.inv_lo[a], self.inv_hi[a]);
+            let d = _mm256_sub_ps(load(self.near[a]), self.near_origin[a]);
+            let entry = bound(_mm256_mul_ps(d, inv_lo), _mm256_mul_ps(d, inv_hi), true);
+            t0 = _mm256_max_ps(entry, t0);
+            let d = _mm256_sub_ps(load(1 - self.near[a]), self.far_origin[a]);
+            let exit = bound(_mm256_mul_ps(d, inv_lo), _mm256_mul_ps(d, inv_hi), false);
+            t1 = _mm256_min_ps(exit, t1);
+        }
+        // An empty slot (+inf minimum, -inf maximum) may pass where an inverse is zero; the
+        // walk stops at the first empty slot.
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
     }
 }
 
@@ -256,5 +331,94 @@ mod tests {
             ruled_out > 1000 && kept > 1000,
             "ruled out {ruled_out}, kept {kept}"
         );
+    }
+
+    /// The eight-lane bounds (AVX2) never rule out a child that one of their rays' slab tests
+    /// enters, with the walk's operations (`max` and `min` keeping the accumulator on a NaN),
+    /// on rays with zero direction components and origins on the boxes' planes; and they rule
+    /// out children, or they would prove nothing.
+    #[test]
+    fn eight_lane_bounds_keep_every_child_a_ray_enters() {
+        use raybench_geom::packet8::{self, Avx2Packets};
+        if Avx2Packets::detect().is_none() {
+            eprintln!("no AVX2 on this CPU: the eight-lane packet bounds never run here");
+            return;
+        }
+        let mut rng = SplitMix64::new(18);
+        let (mut entered, mut ruled_out) = (0u32, 0u32);
+        for _ in 0..300 {
+            let rays: Vec<Ray> = (0..16)
+                .map(|_| {
+                    let o = Vec3::new(
+                        coordinate(&mut rng),
+                        coordinate(&mut rng),
+                        coordinate(&mut rng),
+                    );
+                    let mut d = Vec3::new(
+                        component(&mut rng),
+                        component(&mut rng),
+                        component(&mut rng),
+                    );
+                    if d.abs().max_element() == 0.0 {
+                        d.x = 1.0;
+                    }
+                    Ray::new(o, d, rng.range(0.0, 0.1), f32::INFINITY)
+                })
+                .collect();
+            let mut node = WideNode::<16>::empty();
+            let used = 1 + (rng.next_u64() % 16) as usize;
+            for slot in 0..used {
+                let corner = |rng: &mut SplitMix64| {
+                    Vec3::new(coordinate(rng), coordinate(rng), coordinate(rng))
+                };
+                let (a, b) = (corner(&mut rng), corner(&mut rng));
+                let child = ChildRef {
+                    index: slot as u32,
+                    count: 1,
+                };
+                node.set_child(slot, &Aabb::new(a.min(b), a.max(b)), child);
+            }
+            let packets = RayPackets::new(&rays);
+            let block = &packets.range(0, 16).expect("one whole block")[0];
+            for half in 0..2 {
+                // SAFETY: AVX2 was detected above.
+                unsafe {
+                    let (p, _) = packet8::load(block, half);
+                    packet8::octant_groups(&p, 8, |lanes, octant| {
+                        let f = Frustum8::new(&p, lanes, octant);
+                        for t_max in [f32::INFINITY, 1.5, 0.25] {
+                            let maybe = f.maybe_entered(&node, t_max);
+                            for lane in (0..8).filter(|l| lanes >> l & 1 == 1) {
+                                let ray = &rays[8 * half + lane];
+                                for slot in 0..used {
+                                    if enters(ray, &node, slot, f.near, t_max) {
+                                        assert_eq!(maybe >> slot & 1, 1, "slot {slot}");
+                                        entered += 1;
+                                    }
+                                }
+                            }
+                            ruled_out += used as u32 - (maybe & ((1 << used) - 1)).count_ones();
+                        }
+                    });
+                }
+            }
+        }
+        assert!(
+            entered > 1000 && ruled_out > 1000,
+            "entered {entered}, ruled out {ruled_out}"
+        );
+    }
+
+    /// The walk's slab test of one ray against child `slot` of `n`, far end `t_max`.
+    fn enters(ray: &Ray, n: &WideNode<16>, slot: usize, near: [usize; 3], t_max: f32) -> bool {
+        let (o, inv) = (ray.origin(), ray.inv_dir());
+        let (mut t0, mut t1) = (ray.t_min(), t_max);
+        for a in 0..3 {
+            let entry = (n.planes[a][near[a]][slot] - o[a]) * inv[a];
+            let exit = (n.planes[a][1 - near[a]][slot] - o[a]) * inv[a];
+            t0 = if entry > t0 { entry } else { t0 };
+            t1 = if exit < t1 { exit } else { t1 };
+        }
+        t0 <= t1
     }
 }

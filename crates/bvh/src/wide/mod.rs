@@ -27,7 +27,8 @@
 //! answers. An 8-wide node is tested in one 8-lane AVX2 pass per axis when the CPU has AVX2
 //! (detected at build time) and in two 4-lane SSE passes otherwise (`kernels.rs`); every
 //! kernel is the scalar slab test lane for lane and passes the same conformance tests.
-//! Coherent batches may be traced sixteen rays a packet (`packets.rs`), for closest or any hit.
+//! Coherent batches may be traced in packets, for closest or any hit: sixteen rays a packet
+//! with AVX-512F (`packets.rs`), eight with AVX2 alone (`packets8.rs`).
 //!
 //! Caveat: the collapse only regroups the binary builder's partitions (and splits leaves), so
 //! the wide tree is as good as the binary SAH build under it; and the knobs
@@ -45,7 +46,11 @@ mod pack;
 #[cfg(target_arch = "x86_64")]
 mod packet_node;
 #[cfg(target_arch = "x86_64")]
+mod packet_switch;
+#[cfg(target_arch = "x86_64")]
 mod packets;
+#[cfg(target_arch = "x86_64")]
+mod packets8;
 mod params;
 mod quantized;
 mod stats;
@@ -89,11 +94,35 @@ pub struct BvhWide<const W: usize> {
     mesh: Arc<TriangleMesh>,
     #[cfg(target_arch = "x86_64")]
     avx2: Option<avx2::Avx2Nodes>,
-    /// The packet walk for coherent batches, when asked for and the CPU has AVX-512F.
+    /// The packet walk for coherent batches, when asked for and the CPU has AVX2.
     #[cfg(target_arch = "x86_64")]
-    coherent: Option<raybench_geom::packet::Avx512Packets>,
+    coherent: Option<PacketWalk>,
     /// What the reinsertion optimizer did to the binary tree, when it ran.
     reinsertion: Option<crate::ReinsertStats>,
+}
+
+/// Which packet walk traces coherent batches: sixteen rays a packet on AVX-512F, eight on AVX2.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+enum PacketWalk {
+    Avx512(raybench_geom::packet::Avx512Packets),
+    Avx2(raybench_geom::packet8::Avx2Packets),
+}
+
+#[cfg(target_arch = "x86_64")]
+impl PacketWalk {
+    /// The widest walk this CPU runs; eight lanes where the node kernels are held to AVX2
+    /// (`NodeSimd::Avx2`), so a CPU with AVX-512 can run and test the AVX2 walk too.
+    fn detect(node_simd: NodeSimd) -> Option<PacketWalk> {
+        use raybench_geom::{packet::Avx512Packets, packet8::Avx2Packets};
+        let avx512 = match node_simd {
+            NodeSimd::Avx2 => None,
+            NodeSimd::Auto | NodeSimd::Sse => Avx512Packets::detect(),
+        };
+        avx512
+            .map(PacketWalk::Avx512)
+            .or_else(|| Avx2Packets::detect().map(PacketWalk::Avx2))
+    }
 }
 
 /// 8 children per node, tested in one AVX2 pass per axis: the structure that races Embree.
@@ -143,12 +172,21 @@ impl<const W: usize> BvhWide<W> {
     }
 
     /// Whether coherent batches are traced in packets (`coherent_packets` asked for it and the
-    /// CPU has AVX-512F).
+    /// CPU has AVX2).
     pub fn packet_walk(&self) -> bool {
+        self.packet_lanes().is_some()
+    }
+
+    /// The rays a packet holds when coherent batches are traced in packets: 16 with AVX-512F,
+    /// 8 with AVX2 alone or `NodeSimd::Avx2`.
+    pub fn packet_lanes(&self) -> Option<usize> {
         #[cfg(target_arch = "x86_64")]
-        return self.coherent.is_some();
+        return self.coherent.map(|walk| match walk {
+            PacketWalk::Avx512(_) => raybench_geom::packet::PACKET,
+            PacketWalk::Avx2(_) => raybench_geom::packet8::LANES,
+        });
         #[cfg(not(target_arch = "x86_64"))]
-        false
+        None
     }
 
     /// Whether the batch loops run with AVX-512VL's 32 vector registers (same arithmetic).
@@ -216,7 +254,7 @@ impl<const W: usize> Accel for BvhWide<W> {
             #[cfg(target_arch = "x86_64")]
             coherent: params
                 .coherent_packets
-                .then(raybench_geom::packet::Avx512Packets::detect)
+                .then(|| PacketWalk::detect(params.node_simd))
                 .flatten(),
             reinsertion,
         })
@@ -266,11 +304,19 @@ impl<const W: usize> Accel for BvhWide<W> {
         out: &mut [Option<Hit>],
     ) {
         #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.coherent
+        if let Some(walk) = self.coherent
             && let Some(packets) =
                 raybench_accel::coherent::packet_blocks(prepared, first, out.len())
         {
-            return packets::intersect_coherent(k, self, packets, &rays[first..], first, out);
+            let rays = &rays[first..];
+            return match walk {
+                PacketWalk::Avx512(k) => {
+                    packets::intersect_coherent(k, self, packets, rays, first, out)
+                }
+                PacketWalk::Avx2(k) => {
+                    packets8::intersect_coherent(k, self, packets, rays, first, out)
+                }
+            };
         }
         let rays = &rays[first..];
         with_stack(|stack| {
@@ -292,11 +338,19 @@ impl<const W: usize> Accel for BvhWide<W> {
         out: &mut [bool],
     ) {
         #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.coherent
+        if let Some(walk) = self.coherent
             && let Some(packets) =
                 raybench_accel::coherent::packet_blocks(prepared, first, out.len())
         {
-            return packets::occluded_coherent(k, self, packets, &rays[first..], first, out);
+            let rays = &rays[first..];
+            return match walk {
+                PacketWalk::Avx512(k) => {
+                    packets::occluded_coherent(k, self, packets, rays, first, out)
+                }
+                PacketWalk::Avx2(k) => {
+                    packets8::occluded_coherent(k, self, packets, rays, first, out)
+                }
+            };
         }
         let rays = &rays[first..];
         with_stack(|stack| {

@@ -24,7 +24,8 @@
 //! spacing (the stadium from afar, San Francisco).
 //! Handing sparse subtrees or leaves back to the single-ray walk, as Embree's hybrid traversal
 //! does, did not measurably help (docs/experiments.md, "Packets for coherent rays"); handing
-//! whole packets over does, where the rays share little ([`Switch`], the `packet_floors` knob):
+//! whole packets over does, where the rays share little (`packet_switch.rs`, the `packet_floors`
+//! knob):
 //! a packet walk that carried few rays per node and per `Tri4` sends the next packets of its
 //! window ray by ray.
 //!
@@ -54,28 +55,29 @@ use super::avx2;
 use super::frustum::Frustum;
 use super::node::WideNode;
 use super::packet_node::{children_by_lane, lanes_entering};
+use super::packet_switch::{Usage, each_packet};
 use super::walk::with_stack;
 use crate::node::ChildRef;
 use crate::wide::{BvhWide, STACK};
 use raybench_accel::Hit;
-use raybench_geom::packet::{self, Avx512Packets, Best, PACKET, Packet, RayBlock};
+use raybench_geom::packet::{self, Avx512Packets, Best, Packet, RayBlock};
 use raybench_geom::{NO_PRIM, Ray};
 use std::arch::x86_64::*;
 
 /// A subtree still to visit: its reference, the smallest entry distance among the lanes that
 /// entered its box, and those lanes.
 #[derive(Clone, Copy, Debug, Default)]
-struct Entry {
-    r: ChildRef,
-    t_entry: f32,
-    lanes: u16,
+pub(super) struct Entry {
+    pub(super) r: ChildRef,
+    pub(super) t_entry: f32,
+    pub(super) lanes: u16,
 }
 
-type PacketStack = [Entry; STACK];
+pub(super) type PacketStack = [Entry; STACK];
 
 raybench_accel::per_thread_stack!(
     /// Runs `f` with this thread's packet stack (a fresh one inside another walk).
-    fn with_packet_stack -> PacketStack = Box::new([Entry::default(); STACK])
+    pub(super) fn with_packet_stack -> PacketStack = Box::new([Entry::default(); STACK])
 );
 
 /// Traces a coherent batch (closest hit), one packet per block; `out` gets the first
@@ -125,107 +127,6 @@ fn intersect_packets<const W: usize>(
             }
         },
     );
-}
-
-/// Traces `blocks` (the packets of `rays`, the batch from ray `first` on) into `out`, a
-/// packet at a time: ray by ray through `single` where the [`Switch`] says so, else through
-/// `packet`, which walks one block and reports what its walk shared.
-#[target_feature(enable = "avx512f")]
-#[inline]
-fn each_packet<const W: usize, T>(
-    bvh: &BvhWide<W>,
-    blocks: &[RayBlock],
-    rays: &[Ray],
-    first: usize,
-    out: &mut [T],
-    mut single: impl FnMut(avx2::Avx2Nodes, &[Ray], &mut [T]),
-    mut packet: impl FnMut(&RayBlock, &mut [T], &mut Usage),
-) {
-    let mut switch = Switch::new(bvh, first);
-    for ((block, out), rays) in blocks
-        .iter()
-        .zip(out.chunks_mut(PACKET))
-        .zip(rays.chunks(PACKET))
-    {
-        if let Some(k) = switch.ray_by_ray() {
-            single(k, rays, out);
-            continue;
-        }
-        let mut usage = Usage::default();
-        packet(block, out, &mut usage);
-        switch.walked(usage);
-    }
-}
-
-/// Packets a window holds: the harness's chunk of 256 rays on several threads, so a window's
-/// packets are decided alike whether the batch comes in one call or in chunks.
-const WINDOW: usize = 256 / PACKET;
-
-/// What a packet's walk shared among its rays: the nodes and `Tri4`s it visited, and the lanes
-/// active at each visit, summed.
-#[derive(Clone, Copy, Debug, Default)]
-struct Usage {
-    nodes: u32,
-    node_lanes: u32,
-    tri4s: u32,
-    tri4_lanes: u32,
-}
-
-impl Usage {
-    #[inline(always)]
-    fn node(&mut self, lanes: u16) {
-        self.nodes += 1;
-        self.node_lanes += lanes.count_ones();
-    }
-
-    #[inline(always)]
-    fn tri4s(&mut self, count: u32, lanes: u16) {
-        self.tri4s += count;
-        self.tri4_lanes += count * lanes.count_ones();
-    }
-}
-
-/// Whether the next packet of a batch is walked as a packet or ray by ray
-/// ([`PacketFloors`](crate::PacketFloors)): each window's first packet is walked as one, and
-/// each packet so walked decides for the next. A packet's cost is per visit, whatever its
-/// lanes; the rays' own walks cost per lane. So where few lanes share the nodes and few the
-/// `Tri4`s (triangles smaller than the rays' spacing, rays spread by the surfaces they left),
-/// the rays go faster alone.
-struct Switch {
-    floors: crate::PacketFloors,
-    /// The single-ray kernel, when some packets may be traced ray by ray.
-    single: Option<avx2::Avx2Nodes>,
-    /// The next packet's index in the whole batch.
-    next: usize,
-    packets: bool,
-}
-
-impl Switch {
-    fn new<const W: usize>(bvh: &BvhWide<W>, first: usize) -> Switch {
-        let floors = bvh.params.packet_floors;
-        Switch {
-            floors,
-            single: bvh.avx2.filter(|_| floors.node > 0.0 && floors.tri4 > 0.0),
-            next: first / PACKET,
-            packets: true,
-        }
-    }
-
-    /// The single-ray kernel when the next packet is to be traced ray by ray.
-    #[inline(always)]
-    fn ray_by_ray(&mut self) -> Option<avx2::Avx2Nodes> {
-        if self.next.is_multiple_of(WINDOW) {
-            self.packets = true;
-        }
-        self.next += 1;
-        self.single.filter(|_| !self.packets)
-    }
-
-    #[inline(always)]
-    fn walked(&mut self, u: Usage) {
-        self.packets = u.node_lanes as f32 >= self.floors.node * u.nodes as f32
-            || u.tri4_lanes as f32 >= self.floors.tri4 * u.tri4s as f32;
-    }
 }
 
 /// The walk of the `active` lanes, whose directions all lie in `octant`. Each subtree is
@@ -355,7 +256,7 @@ fn each_entered<const W: usize, const DISTANCE: bool>(
 /// Pushes `e` onto `stack[base..*sp]`, kept in decreasing entry distance so the nearest is on
 /// top (a later slot goes below earlier ones at the same distance).
 #[inline(always)]
-fn push_sorted(stack: &mut PacketStack, base: usize, sp: &mut usize, e: Entry) {
+pub(super) fn push_sorted(stack: &mut PacketStack, base: usize, sp: &mut usize, e: Entry) {
     let mut j = *sp;
     while j > base && stack[j - 1].t_entry <= e.t_entry {
         stack[j] = stack[j - 1];

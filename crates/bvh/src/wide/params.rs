@@ -12,7 +12,7 @@ pub enum NodeSimd {
     #[default]
     Auto,
     /// AVX2 when the CPU has it, never AVX-512's registers: the same arithmetic as `Auto`,
-    /// for comparing the two batch loops.
+    /// for comparing the two batch loops; packets (`coherent_packets`) of eight rays.
     Avx2,
     /// 4-lane SSE: one pass per axis and four children, one `Tri4` (four triangles) a pass
     /// (the x86-64 baseline; portable code elsewhere).
@@ -64,9 +64,9 @@ pub struct WideParams {
     pub fill_slots: bool,
     /// Batches prepared as coherent (`Accel::prepare_coherent_rays`: the primary and shadow
     /// rays) are traced for closest or any hit sixteen rays at a time, one per AVX-512 lane
-    /// (`packets.rs`),
-    /// when the CPU has AVX-512F; every other batch, and every batch without AVX-512, ray by
-    /// ray. The registry's `bvh8-packets`.
+    /// (`packets.rs`), when the CPU has AVX-512F, else eight at a time, one per AVX2 lane
+    /// (`packets8.rs`; also with `NodeSimd::Avx2`); every other batch, and every batch
+    /// without AVX2, ray by ray. The registry's `bvh8-packets`.
     pub coherent_packets: bool,
     /// With `coherent_packets`: when a packet is worth walking as one (else its rays are traced
     /// ray by ray). Off by default: every packet is walked as one.

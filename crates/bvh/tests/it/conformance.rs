@@ -418,7 +418,7 @@ fn too_large_is_an_error_not_an_abort() {
 /// The packet walk (`coherent_packets`) under the shared suite (whose coherent-batch check
 /// holds it to brute force), and on every case's rays bit-identical to the single-ray walk but
 /// for ties: each lane computes its ray's single-ray arithmetic, and walks only the boxes its
-/// ray entered. Without AVX-512F the batches are walked ray by ray and both checks still hold.
+/// ray entered. Without AVX2 the batches are walked ray by ray and both checks still hold.
 #[test]
 fn packet_walk_conforms() {
     use raybench_accel::Accel;
@@ -452,7 +452,7 @@ fn packet_walk_conforms() {
 /// single-ray walk does, bit for bit, except on exact ties between two triangles (19,680 of the
 /// 20,049 rays from inside the city, which meet pairs of coincident faces there; 20 of 20,000
 /// elsewhere, with leaves of at most 8 triangles). Returns without checking (and says so) on a CPU
-/// without AVX-512F.
+/// without AVX2 (sixteen lanes with AVX-512F, eight with AVX2 alone).
 #[test]
 fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
     use raybench_accel::{Accel, PreparedRays};
@@ -472,7 +472,7 @@ fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
         let mesh = scene.mesh.clone();
         let bvh = Bvh8::build(mesh.clone(), &params).expect("builds");
         if !bvh.packet_walk() {
-            eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to compare");
+            eprintln!("no AVX2 on this CPU: the packet walk is not used, nothing to compare");
             return;
         }
         for rays in raybench_testkit::camera_ray_sets(&scene, 20_000) {

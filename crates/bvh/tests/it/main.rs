@@ -3,6 +3,7 @@
 
 mod conformance;
 mod packet_floors;
+mod packets8;
 mod packets_any_hit;
 mod packets_frustum;
 mod quantized;

@@ -4,7 +4,7 @@
 //! (ties included, which is what shows they were handed over), the decisions are the same
 //! whether a batch comes in one call or in the harness's chunks of 256 rays (so the answers are
 //! the same on any number of threads), and the shared suite holds with the registry's floors.
-//! On a CPU without AVX-512F every batch is traced ray by ray and the checks say so.
+//! On a CPU without AVX2 every batch is traced ray by ray and the checks say so.
 
 use raybench_accel::Accel;
 use raybench_bvh::{Bvh8, PacketFloors, WideParams};
@@ -28,7 +28,7 @@ fn tree_and_rays(spec: &str, seed: u64, floors: PacketFloors) -> Option<(Bvh8, V
     let scene = scenes::generate(spec, seed).expect("generates");
     let bvh = Bvh8::build(scene.mesh.clone(), &packets(floors)).expect("builds");
     if !bvh.packet_walk() {
-        eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to check");
+        eprintln!("no AVX2 on this CPU: the packet walk is not used, nothing to check");
         return None;
     }
     let rays = camera_ray_sets(&scene, 6_000)

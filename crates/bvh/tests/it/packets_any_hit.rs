@@ -3,7 +3,7 @@
 //! bit — on the seeded cases and edge cases, on shadow rays from camera hits (rays starting on
 //! surfaces, finite `t` ranges, several octants per packet), on camera rays cut to `t` windows,
 //! in ranges that end inside a packet and that start off a packet boundary. On a CPU without
-//! AVX-512F the batches are traced ray by ray and the checks still hold (and say so).
+//! AVX2 the batches are traced ray by ray and the checks still hold (and say so).
 
 use raybench_accel::Accel;
 use raybench_bvh::{Bvh8, BvhWide, WideParams};
@@ -53,7 +53,7 @@ fn any_hit_packets_answer_shadow_rays_as_single_rays() {
         let bvh = Bvh8::build(scene.mesh.clone(), &packets(8)).expect("builds");
         bvh.validate(&scene.mesh).expect("valid");
         if !bvh.packet_walk() {
-            eprintln!("no AVX-512F on this CPU: batches go ray by ray");
+            eprintln!("no AVX2 on this CPU: batches go ray by ray");
         }
         for rays in shadow_ray_sets(&scene, &bvh, 8_000) {
             occluded += occlusion_packets_against_single_rays(&bvh, &rays, spec);

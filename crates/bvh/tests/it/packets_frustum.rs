@@ -69,7 +69,7 @@ fn packet_tree(mesh: &Arc<TriangleMesh>) -> Option<Bvh8> {
     let bvh = Bvh8::build(mesh.clone(), &params).expect("builds");
     bvh.validate(mesh).expect("valid");
     if !bvh.packet_walk() {
-        eprintln!("no AVX-512F on this CPU: the packet walk is not used, nothing to compare");
+        eprintln!("no AVX2 on this CPU: the packet walk is not used, nothing to compare");
         return None;
     }
     Some(bvh)
