@@ -6,8 +6,8 @@
 //! one walk per octant present, the same [`Switch`](super::packet_switch) handing packets to
 //! the single-ray walk where their rays share little. Eight lanes halve what one visit does
 //! for the rays, so a packet pays where its rays share nodes and leaves a little less than on
-//! AVX-512. Where few lanes reach a node, every child is still tested against the packet:
-//! with eight lanes the lane-by-lane test of `packet_node.rs` has less to save.
+//! AVX-512. Where few lanes reach a node, it is tested lane by lane, and where one or two
+//! reach a leaf, its (triangle, ray) pairs are tested in one pass, as on AVX-512.
 //!
 //! Exactness as in `packets.rs`: every lane computes its ray's slab tests and triangle tests
 //! with the single-ray walk's operations in the same order, so each ray's hit, `t`, `u` and
