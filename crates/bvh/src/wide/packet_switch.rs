@@ -9,10 +9,11 @@ use raybench_geom::Ray;
 use raybench_geom::packet::{PACKET, RayBlock};
 
 /// Traces `blocks` (the packets of `rays`, the batch from ray `first` on) into `out`, a
-/// packet at a time: ray by ray through `single` where the [`Switch`] says so, else through
-/// `packet`, which walks one block and reports what its walk shared.
+/// block at a time: ray by ray through `single` where the [`Switch`] says so, else through
+/// `packet`, which walks one block in packets of `lanes` rays and reports what its walk shared.
 #[inline(always)]
 pub(super) fn each_packet<const W: usize, T>(
+    lanes: usize,
     bvh: &BvhWide<W>,
     blocks: &[RayBlock],
     rays: &[Ray],
@@ -21,7 +22,7 @@ pub(super) fn each_packet<const W: usize, T>(
     mut single: impl FnMut(avx2::Avx2Nodes, &[Ray], &mut [T]),
     mut packet: impl FnMut(&RayBlock, &mut [T], &mut Usage),
 ) {
-    let mut switch = Switch::new(bvh, first);
+    let mut switch = Switch::new(bvh, first, lanes);
     for ((block, out), rays) in blocks
         .iter()
         .zip(out.chunks_mut(PACKET))
@@ -70,7 +71,8 @@ impl Usage {
 /// each packet so walked decides for the next. A packet's cost is per visit, whatever its
 /// lanes; the rays' own walks cost per lane. So where few lanes share the nodes and few the
 /// `Tri4`s (triangles smaller than the rays' spacing, rays spread by the surfaces they left),
-/// the rays go faster alone.
+/// the rays go faster alone. The floors are counted in rays of a sixteen-lane packet; a walk of
+/// narrower packets, whose visits cost less, scales them to its width.
 struct Switch {
     floors: crate::PacketFloors,
     /// The single-ray kernel, when some packets may be traced ray by ray.
@@ -81,10 +83,14 @@ struct Switch {
 }
 
 impl Switch {
-    fn new<const W: usize>(bvh: &BvhWide<W>, first: usize) -> Switch {
+    fn new<const W: usize>(bvh: &BvhWide<W>, first: usize, lanes: usize) -> Switch {
         let floors = bvh.params.packet_floors;
+        let scale = lanes as f32 / PACKET as f32;
         Switch {
-            floors,
+            floors: crate::PacketFloors {
+                node: floors.node * scale,
+                tri4: floors.tri4 * scale,
+            },
             single: bvh.avx2.filter(|_| floors.node > 0.0 && floors.tri4 > 0.0),
             next: first / PACKET,
             packets: true,

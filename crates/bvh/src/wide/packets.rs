@@ -60,7 +60,7 @@ use super::walk::with_stack;
 use crate::node::ChildRef;
 use crate::wide::{BvhWide, STACK};
 use raybench_accel::Hit;
-use raybench_geom::packet::{self, Avx512Packets, Best, Packet, RayBlock};
+use raybench_geom::packet::{self, Avx512Packets, Best, PACKET, Packet, RayBlock};
 use raybench_geom::{NO_PRIM, Ray};
 use std::arch::x86_64::*;
 
@@ -109,6 +109,7 @@ fn intersect_packets<const W: usize>(
         with_stack(|s| avx2::intersect_all(bvh, k, rays, out, s))
     };
     each_packet(
+        PACKET,
         bvh,
         blocks,
         rays,
@@ -295,6 +296,7 @@ fn occluded_packets<const W: usize>(
         with_stack(|s| avx2::occluded_all(bvh, k, rays, out, s))
     };
     each_packet(
+        PACKET,
         bvh,
         blocks,
         rays,

@@ -59,6 +59,7 @@ fn intersect_packets<const W: usize>(
         with_stack(|s| avx2::intersect_all(bvh, k, rays, out, s))
     };
     each_packet(
+        LANES,
         bvh,
         blocks,
         rays,
@@ -322,6 +323,7 @@ fn occluded_packets<const W: usize>(
         with_stack(|s| avx2::occluded_all(bvh, k, rays, out, s))
     };
     each_packet(
+        LANES,
         bvh,
         blocks,
         rays,

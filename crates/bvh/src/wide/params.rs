@@ -82,7 +82,9 @@ pub struct WideParams {
 /// average, at least `node` rays per node visited or at least `tri4` rays per `Tri4` tested;
 /// else the window's remaining packets go ray by ray. Zero in either field walks every packet
 /// as one, and so does a tree without the AVX2 kernels (`node_simd = sse`): packets are handed
-/// to the AVX2 single-ray loops.
+/// to the AVX2 single-ray loops. The floors count rays of a sixteen-lane packet; the eight-lane
+/// walk (AVX2 without AVX-512F) scales them to its width, so [`PacketFloors::MEASURED`] walks
+/// every packet there (a floor of one ray a `Tri4` always holds).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PacketFloors {
     pub node: f32,
