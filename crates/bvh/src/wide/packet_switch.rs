@@ -10,10 +10,9 @@ use raybench_geom::packet::{PACKET, RayBlock};
 
 /// Traces `blocks` (the packets of `rays`, the batch from ray `first` on) into `out`, a
 /// block at a time: ray by ray through `single` where the [`Switch`] says so, else through
-/// `packet`, which walks one block in packets of `lanes` rays and reports what its walk shared.
+/// `packet`, which walks one block in packets of `LANES` rays and reports what its walk shared.
 #[inline(always)]
-pub(super) fn each_packet<const W: usize, T>(
-    lanes: usize,
+pub(super) fn each_packet<const LANES: usize, const W: usize, T>(
     bvh: &BvhWide<W>,
     blocks: &[RayBlock],
     rays: &[Ray],
@@ -22,7 +21,7 @@ pub(super) fn each_packet<const W: usize, T>(
     mut single: impl FnMut(avx2::Avx2Nodes, &[Ray], &mut [T]),
     mut packet: impl FnMut(&RayBlock, &mut [T], &mut Usage),
 ) {
-    let mut switch = Switch::new(bvh, first, lanes);
+    let mut switch = Switch::new(bvh, first, LANES);
     for ((block, out), rays) in blocks
         .iter()
         .zip(out.chunks_mut(PACKET))

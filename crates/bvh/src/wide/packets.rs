@@ -108,8 +108,7 @@ fn intersect_packets<const W: usize>(
     let single = |k, rays: &[Ray], out: &mut [Option<Hit>]| {
         with_stack(|s| avx2::intersect_all(bvh, k, rays, out, s))
     };
-    each_packet(
-        PACKET,
+    each_packet::<PACKET, W, _>(
         bvh,
         blocks,
         rays,
@@ -295,8 +294,7 @@ fn occluded_packets<const W: usize>(
     let single = |k, rays: &[Ray], out: &mut [bool]| {
         with_stack(|s| avx2::occluded_all(bvh, k, rays, out, s))
     };
-    each_packet(
-        PACKET,
+    each_packet::<PACKET, W, _>(
         bvh,
         blocks,
         rays,

@@ -58,8 +58,7 @@ fn intersect_packets<const W: usize>(
     let single = |k, rays: &[Ray], out: &mut [Option<Hit>]| {
         with_stack(|s| avx2::intersect_all(bvh, k, rays, out, s))
     };
-    each_packet(
-        LANES,
+    each_packet::<LANES, W, _>(
         bvh,
         blocks,
         rays,
@@ -322,8 +321,7 @@ fn occluded_packets<const W: usize>(
     let single = |k, rays: &[Ray], out: &mut [bool]| {
         with_stack(|s| avx2::occluded_all(bvh, k, rays, out, s))
     };
-    each_packet(
-        LANES,
+    each_packet::<LANES, W, _>(
         bvh,
         blocks,
         rays,
