@@ -23,13 +23,16 @@ use std::arch::x86_64::*;
 /// Rays in a packet: one per AVX2 lane, half a [`RayBlock`].
 pub const LANES: usize = 8;
 
-/// Proof that this CPU runs AVX2 (the only way to reach the 8-lane packet code).
+/// Proof that this CPU runs AVX2 and POPCNT (the only way to reach the 8-lane packet code;
+/// the walks count lanes with POPCNT, which every AVX2 CPU has).
 #[derive(Clone, Copy, Debug)]
 pub struct Avx2Packets(());
 
 impl Avx2Packets {
     pub fn detect() -> Option<Avx2Packets> {
-        std::arch::is_x86_feature_detected!("avx2").then_some(Avx2Packets(()))
+        let avx2 = std::arch::is_x86_feature_detected!("avx2");
+        let popcnt = std::arch::is_x86_feature_detected!("popcnt");
+        (avx2 && popcnt).then_some(Avx2Packets(()))
     }
 }
 

@@ -290,7 +290,7 @@ fn own_structures() -> Vec<StructureEntry> {
         ),
         register::<KdTree>(
             "kd-packets",
-            "the kd-sah tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane (Wald 2004), every other batch ray by ray as kd-sah",
+            "the kd-sah tree; coherent batches (primary rays for closest hit, shadow rays for any hit) traced sixteen consecutive rays a packet, one per AVX-512 lane (two packets of eight AVX2 lanes on a CPU without AVX-512F; Wald 2004), every other batch ray by ray as kd-sah",
             None,
             |_| KdParams::packets(),
         ),

@@ -13,15 +13,17 @@
 //! |---|---|---|
 //! | `kd-sah` | SAH with perfect splits, event sweep, O(N log N) | Wald and Havran 2006 |
 //! | `kd-median` | spatial median, round-robin axes | the textbook baseline |
-//! | `kd-packets` | `kd-sah`, coherent batches walked sixteen rays at a time (`packets.rs`) | Wald 2004 |
+//! | `kd-packets` | `kd-sah`, coherent batches walked sixteen rays at a time (`packets.rs`; eight with AVX2 alone, `packets8.rs`) | Wald 2004 |
 //! | `kd-sah-exhaustive` | `kd-sah`, walked without early exit: what stopping at the first hit saves | — |
-#![deny(unsafe_code)] // allowed only in the AVX-512 packet walk, `packets.rs`
+#![deny(unsafe_code)] // allowed only in the packet walks, `packets.rs` and `packets8.rs`
 
 pub mod build;
 pub mod clip;
 mod node;
 #[cfg(target_arch = "x86_64")]
 mod packets;
+#[cfg(target_arch = "x86_64")]
+mod packets8;
 mod points;
 mod traverse;
 mod validate;
@@ -68,7 +70,8 @@ pub struct KdParams {
     pub leaf_size: u32,
     /// Trace coherent batches (`Accel::prepare_coherent_rays`: camera rays in scanline order,
     /// and the shadow rays from their hits) as packets of sixteen rays on CPUs with AVX-512F,
-    /// for closest or any hit; other batches and other CPUs take the single-ray walk.
+    /// of eight on CPUs with AVX2 alone, for closest or any hit; other batches and other CPUs
+    /// take the single-ray walk.
     pub packets: bool,
     /// Record tested triangles in a small per-ray table so a triangle referenced by several
     /// leaves is tested once (skips are counted as `mailbox_skips`).
@@ -200,9 +203,28 @@ pub struct KdTree {
     /// The zero-area triangles rays never hit, in a tree of their own that only closest-point
     /// queries walk (`None` when the mesh has none; see [`build`]).
     zero_area: Option<Box<KdTree>>,
-    /// Set when coherent batches are traced as packets (`packets` and AVX-512F detected).
+    /// Set when coherent batches are traced as packets (`packets` and AVX2 detected).
     #[cfg(target_arch = "x86_64")]
-    coherent: Option<raybench_geom::packet::Avx512Packets>,
+    coherent: Option<PacketWalk>,
+}
+
+/// Which packet walk traces coherent batches: sixteen rays a packet on AVX-512F, eight on AVX2.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+enum PacketWalk {
+    Avx512(raybench_geom::packet::Avx512Packets),
+    Avx2(raybench_geom::packet8::Avx2Packets),
+}
+
+#[cfg(target_arch = "x86_64")]
+impl PacketWalk {
+    /// The widest walk this CPU runs.
+    fn detect() -> Option<PacketWalk> {
+        use raybench_geom::{packet::Avx512Packets, packet8::Avx2Packets};
+        Avx512Packets::detect()
+            .map(PacketWalk::Avx512)
+            .or_else(|| Avx2Packets::detect().map(PacketWalk::Avx2))
+    }
 }
 
 impl KdTree {
@@ -226,7 +248,7 @@ impl KdTree {
         &self.bounds
     }
 
-    /// Whether coherent batches are traced as packets (`packets` set and AVX-512F present).
+    /// Whether coherent batches are traced as packets (`packets` set and AVX2 present).
     pub fn packet_walk(&self) -> bool {
         #[cfg(target_arch = "x86_64")]
         return self.coherent.is_some();
@@ -301,11 +323,15 @@ impl Accel for KdTree {
         out: &mut [Option<Hit>],
     ) {
         #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.coherent
+        if let Some(walk) = self.coherent
             && let Some(blocks) =
                 raybench_accel::coherent::packet_blocks(prepared, first, out.len())
         {
-            return packets::intersect_coherent(k, self, &rays[first..], blocks, out);
+            let rays = &rays[first..];
+            return match walk {
+                PacketWalk::Avx512(k) => packets::intersect_coherent(k, self, rays, blocks, out),
+                PacketWalk::Avx2(k) => packets8::intersect_coherent(k, self, rays, blocks, out),
+            };
         }
         for (o, ray) in out.iter_mut().zip(&rays[first..]) {
             *o = self.intersect(ray);
@@ -320,11 +346,15 @@ impl Accel for KdTree {
         out: &mut [bool],
     ) {
         #[cfg(target_arch = "x86_64")]
-        if let Some(k) = self.coherent
+        if let Some(walk) = self.coherent
             && let Some(blocks) =
                 raybench_accel::coherent::packet_blocks(prepared, first, out.len())
         {
-            return packets::occluded_coherent(k, self, &rays[first..], blocks, out);
+            let rays = &rays[first..];
+            return match walk {
+                PacketWalk::Avx512(k) => packets::occluded_coherent(k, self, rays, blocks, out),
+                PacketWalk::Avx2(k) => packets8::occluded_coherent(k, self, rays, blocks, out),
+            };
         }
         for (o, ray) in out.iter_mut().zip(&rays[first..]) {
             *o = self.occluded(ray);
@@ -375,10 +405,7 @@ impl KdTree {
             mesh: mesh.clone(),
             zero_area: None,
             #[cfg(target_arch = "x86_64")]
-            coherent: params
-                .packets
-                .then(raybench_geom::packet::Avx512Packets::detect)
-                .flatten(),
+            coherent: params.packets.then(PacketWalk::detect).flatten(),
         })
     }
 }

@@ -1,7 +1,7 @@
 //! `kd-packets` on coherent any-hit batches: every ray's answer is its single-ray `occluded`'s,
 //! on the seeded cases and edge cases and on shadow rays from camera hits (rays starting on
 //! surfaces, finite `t` ranges, packets spanning octants), in ranges that end inside a packet and
-//! that start off a packet boundary (the testkit helper). On a CPU without AVX-512F the batches
+//! that start off a packet boundary (the testkit helper). On a CPU without AVX2 the batches
 //! go ray by ray and the checks still hold.
 
 use raybench_accel::Accel;
@@ -34,7 +34,7 @@ fn any_hit_packets_answer_shadow_rays_as_single_rays() {
         let kd = KdTree::build(scene.mesh.clone(), &KdParams::packets()).expect("builds");
         kd.validate(&scene.mesh).expect("valid");
         if !kd.packet_walk() {
-            eprintln!("no AVX-512F on this CPU: batches go ray by ray");
+            eprintln!("no AVX2 on this CPU: batches go ray by ray");
         }
         for rays in shadow_ray_sets(&scene, &kd, 6_000) {
             occluded += occlusion_packets_against_single_rays(&kd, &rays, spec);

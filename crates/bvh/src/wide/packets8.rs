@@ -40,8 +40,7 @@ pub(crate) fn intersect_coherent<const W: usize>(
     out: &mut [Option<Hit>],
 ) {
     with_packet_stack(|stack| {
-        // SAFETY: an `Avx2Packets` exists only after `detect` saw AVX2 on this CPU, and every
-        // AVX2 CPU has POPCNT.
+        // SAFETY: an `Avx2Packets` exists only after `detect` saw AVX2 and POPCNT on this CPU.
         unsafe { intersect_packets(bvh, blocks, rays, first, out, stack) }
     })
 }
@@ -303,8 +302,7 @@ pub(crate) fn occluded_coherent<const W: usize>(
     out: &mut [bool],
 ) {
     with_packet_stack(|stack| {
-        // SAFETY: an `Avx2Packets` exists only after `detect` saw AVX2 on this CPU, and every
-        // AVX2 CPU has POPCNT.
+        // SAFETY: an `Avx2Packets` exists only after `detect` saw AVX2 and POPCNT on this CPU.
         unsafe { occluded_packets(bvh, blocks, rays, first, out, stack) }
     })
 }
