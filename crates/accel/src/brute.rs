@@ -1,10 +1,17 @@
 //! BruteForce: tests every triangle against every ray (and every query point). O(N) per query,
 //! no build, no cleverness — which is the point: it is the oracle the other structures are
 //! checked against. Ties (equal t, or equal distance for closest-point queries) resolve to the
-//! lowest primitive index.
+//! lowest primitive index. Concessions to speed that change no answer and no counter: a ray
+//! scan tests blocks of triangles without branches first (the same arithmetic, for Möller–
+//! Trumbore and the watertight test alike) and runs the test that decides only on the
+//! triangles that passed; the closest-point scan skips triangles whose boxes are clearly
+//! farther than the best so far.
 
 use crate::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, Nearest, PointHit};
-use raybench_geom::{MollerTriangle, Ray, TriHit, Triangle, TriangleMesh, TriangleTest, Vec3};
+use raybench_geom::{
+    MollerTriangle, Ray, TriHit, Triangle, TriangleMesh, TriangleTest, Vec3, WatertightRay,
+    box_distance_squared,
+};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -20,6 +27,9 @@ pub struct BruteForce {
     /// The original vertices, for closest-point queries: `MollerTriangle` keeps edges, and
     /// `v0 - e1` does not always give back `v1` exactly.
     mesh: Arc<TriangleMesh>,
+    /// The largest coordinate magnitude of the mesh (infinite when empty), which scales the
+    /// closest-point scan's slack.
+    extent: f32,
 }
 
 /// Triangles in the layout their test wants: Möller–Trumbore reads Embree's precomputed
@@ -33,52 +43,91 @@ enum Triangles {
 impl BruteForce {
     fn trace<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
         match &self.triangles {
-            Triangles::Moller(t) => scan::<ANY_HIT, _, _>(t, ray, c, |t, r| t.intersect(r)),
+            Triangles::Moller(t) => {
+                scan::<ANY_HIT, _, _>(t, ray, c, MollerTriangle::hits, MollerTriangle::intersect)
+            }
             Triangles::Vertices(t) => {
-                scan::<ANY_HIT, _, _>(t, ray, c, |t, r| t.intersect_watertight(r))
+                let w = WatertightRay::new(ray);
+                scan::<ANY_HIT, _, _>(
+                    t,
+                    ray,
+                    c,
+                    |t, r| w.with_window_of(r).may_hit(t),
+                    |t, r| w.with_window_of(r).intersect(t),
+                )
             }
         }
     }
 }
 
 /// The one loop: every triangle, keeping the closest hit (the lowest index on equal t), or
-/// stopping at the first hit for any-hit queries.
+/// stopping at the first hit for any-hit queries. `test` decides every answer; `may_hit`, a
+/// test that never says no where `test` would hit, is run first on blocks of triangles, so
+/// that `test` (whose branches a scan mispredicts) runs only where it can hit.
 #[inline(always)]
 fn scan<const ANY_HIT: bool, T, C: CounterSink>(
     tris: &[T],
     ray: &Ray,
     c: &mut C,
+    may_hit: impl Fn(&T, &Ray) -> bool,
     test: impl Fn(&T, &Ray) -> Option<TriHit>,
 ) -> Option<Hit> {
+    const BLOCK: usize = 32;
     let mut best: Option<Hit> = None;
     let mut r = *ray;
-    for (prim, tri) in tris.iter().enumerate() {
-        c.prim_tests(1);
-        let Some(h) = test(tri, &r) else { continue };
-        if best.is_some_and(|b| h.t >= b.t) {
-            continue; // equal t: keep the lower primitive index
+    for (b, block) in tris.chunks(BLOCK).enumerate() {
+        // Every triangle of the block against the window at its start: a later hit only
+        // narrows it, so this never drops a triangle `test` would hit.
+        let mut candidates = 0u32;
+        for (i, tri) in block.iter().enumerate() {
+            candidates |= (may_hit(tri, &r) as u32) << i;
         }
-        best = Some(Hit::from_tri_hit(prim as u32, h));
-        if ANY_HIT {
-            break;
+        while candidates != 0 {
+            let i = candidates.trailing_zeros() as usize;
+            candidates &= candidates - 1;
+            let Some(h) = test(&block[i], &r) else {
+                continue;
+            };
+            if best.is_some_and(|b| h.t >= b.t) {
+                continue; // equal t: keep the lower primitive index
+            }
+            best = Some(Hit::from_tri_hit((b * BLOCK + i) as u32, h));
+            if ANY_HIT {
+                // Counted as the one-by-one loop counts: up to the first hit.
+                c.prim_tests((b * BLOCK + i + 1) as u64);
+                return best;
+            }
+            r = r.with_t_max(h.t);
         }
-        r = r.with_t_max(h.t);
     }
+    c.prim_tests(tris.len() as u64);
     best
 }
 
 /// The closest-point scan: every triangle's exact closest point, keeping the nearest within
 /// the radius (the lowest index on equal distance, [`Nearest`]'s rule). One `prim_tests` per
-/// point–triangle distance.
+/// triangle, as if every distance were computed. A triangle whose box is clearly farther than
+/// the best so far is skipped without its distance: farther by a relative 2^-10 and by 2^-20 of
+/// the largest coordinate, which no rounding of the nearest point (computed in f64, rounded to
+/// f32) comes near, so the oracle does not lean on the exact box rule the structures prune
+/// with. A later triangle wins only by being nearer (ties go to the lower index), so a skipped
+/// one could not have won.
 fn closest_point_scan<C: CounterSink>(
     mesh: &TriangleMesh,
+    extent: f32,
     p: Vec3,
     max_radius: f32,
     c: &mut C,
 ) -> Option<PointHit> {
     let mut nearest = Nearest::within(p, max_radius)?;
-    for (prim, tri) in mesh.triangles().enumerate() {
+    let slack = (extent.max(p.abs().max_element()) as f64 * (-20f64).exp2()).powi(2);
+    for prim in 0..mesh.len() {
         c.prim_tests(1);
+        let tri = mesh.triangle(prim);
+        let bound = nearest.bound_d2() as f64;
+        if box_distance_squared(p, &tri.bounds()) as f64 > bound + bound / 1024.0 + slack {
+            continue;
+        }
         nearest.test_triangle(p, prim as u32, &tri);
     }
     nearest.into_hit()
@@ -107,10 +156,13 @@ impl Accel for BruteForce {
             }
             TriangleTest::Watertight => Triangles::Vertices(mesh.triangles().collect()),
         };
+        let b = mesh.bounds();
+        let extent = b.min.abs().max(b.max.abs()).max_element();
         Ok(BruteForce {
             name: name.to_string(),
             triangles,
             mesh,
+            extent,
         })
     }
 
@@ -151,7 +203,7 @@ impl crate::Walk for BruteForce {
     }
 
     fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
-        closest_point_scan(&self.mesh, p, max_radius, c)
+        closest_point_scan(&self.mesh, self.extent, p, max_radius, c)
     }
 }
 
@@ -270,6 +322,121 @@ mod tests {
         let (empty, _) = TriangleMesh::new(vec![], vec![]).unwrap();
         let bf = BruteForce::build(Arc::new(empty), &Default::default()).unwrap();
         assert_eq!(bf.closest_point(Vec3::ZERO, f32::INFINITY), None);
+    }
+
+    /// The scan in blocks (the branch-free test first) answers and counts as a plain loop over
+    /// every triangle with the Möller test: closest hit (ties to the lower index, layered and
+    /// repeated triangles), any hit, and `prim_tests` up to the first hit, on a soup whose
+    /// last block is partial.
+    #[test]
+    fn the_blocked_scan_answers_and_counts_as_one_triangle_at_a_time() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut v = || Vec3::new(next(), next(), next());
+        let mut tris: Vec<Triangle> = (0..1_000)
+            .map(|_| {
+                let c = v() * 4.0;
+                Triangle::new(c + v() - Vec3::splat(0.5), c + v(), c - v())
+            })
+            .collect();
+        // A repeated triangle in a later block: equal t, the earlier index must win.
+        tris.push(tris[7]);
+        tris.extend_from_within(40..45);
+        let mesh = Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0);
+        let bf = BruteForce::build(mesh.clone(), &Default::default()).unwrap();
+        let moller: Vec<_> = mesh.triangles().map(|t| MollerTriangle::new(&t)).collect();
+        let (mut hit, mut missed) = (0, 0);
+        for i in 0..2_000 {
+            let o = v() * 6.0 - Vec3::ONE;
+            let d = if i % 2 == 0 {
+                v() - Vec3::splat(0.5)
+            } else {
+                moller[i % 1_000].v0 - o
+            };
+            let t_max = if i % 5 == 0 { 2.0 } else { f32::INFINITY };
+            let ray = Ray::new(o, d, 0.0, t_max);
+            // The plain loop: every triangle in order, the window shrinking at each hit.
+            let (mut best, mut r, mut first_hit) = (None::<Hit>, ray, None);
+            for (prim, m) in moller.iter().enumerate() {
+                if let Some(h) = m.intersect(&r) {
+                    first_hit.get_or_insert(prim as u64 + 1);
+                    if !best.is_some_and(|b| h.t >= b.t) {
+                        best = Some(Hit::from_tri_hit(prim as u32, h));
+                        r = r.with_t_max(h.t);
+                    }
+                }
+            }
+            let mut c = Counters::default();
+            assert_eq!(bf.intersect_counted(&ray, &mut c), best, "ray {i}");
+            assert_eq!(c.prim_tests, moller.len() as u64);
+            let mut c = Counters::default();
+            assert_eq!(bf.occluded_counted(&ray, &mut c), best.is_some(), "ray {i}");
+            assert_eq!(
+                c.prim_tests,
+                first_hit.unwrap_or(moller.len() as u64),
+                "ray {i}"
+            );
+            if best.is_some() {
+                hit += 1
+            } else {
+                missed += 1
+            }
+        }
+        assert!(hit > 500 && missed > 500, "{hit} hits, {missed} misses");
+    }
+
+    /// The closest-point scan with its box skip answers as testing every triangle does, at
+    /// three scales (unit, tiny and far from the origin), for points near the triangles and
+    /// far from them, at an infinite radius and a small one, with repeated triangles (ties).
+    #[test]
+    fn the_closest_point_scan_answers_as_testing_every_triangle() {
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut found_some = false;
+        for (scale, offset) in [(1.0, 0.0), (1e-15, 0.0), (1.0, 1e6)] {
+            let mut v = || Vec3::new(next(), next(), next());
+            let at = |x: Vec3| x * scale + Vec3::splat(offset);
+            let mut tris: Vec<Triangle> = (0..600)
+                .map(|_| {
+                    let c = v() * 8.0;
+                    Triangle::new(at(c), at(c + v()), at(c - v()))
+                })
+                .collect();
+            tris.extend_from_within(10..20);
+            let mesh = Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0);
+            let bf = BruteForce::build(mesh.clone(), &Default::default()).unwrap();
+            for i in 0..400 {
+                let p = if i % 2 == 0 {
+                    mesh.triangle(i % tris.len()).v1 + (v() - Vec3::splat(0.5)) * scale * 0.01
+                } else {
+                    at(v() * 12.0 - Vec3::splat(2.0))
+                };
+                for radius in [f32::INFINITY, 0.5 * scale] {
+                    let mut every = Nearest::within(p, radius).unwrap();
+                    let mut distances = 0;
+                    for (prim, tri) in mesh.triangles().enumerate() {
+                        every.test_triangle(p, prim as u32, &tri);
+                        distances += 1;
+                    }
+                    let mut c = Counters::default();
+                    let got = bf.closest_point_counted(p, radius, &mut c);
+                    assert_eq!(got, every.into_hit(), "scale {scale}, point {i}, {radius}");
+                    assert_eq!(c.prim_tests, distances);
+                    found_some |= got.is_some();
+                }
+            }
+        }
+        assert!(found_some);
     }
 
     #[test]

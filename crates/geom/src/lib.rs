@@ -6,7 +6,7 @@
 //!   and hits flat (zero-thickness) boxes.
 //! * [`Triangle`] and [`TriangleMesh`], with the two ray–triangle tests raybench uses:
 //!   Möller–Trumbore in the form Embree's fast mode uses, and the watertight test of
-//!   Woop, Benthin and Wald (2013).
+//!   Woop, Benthin and Wald (2013), whose per-ray set-up [`WatertightRay`] holds.
 //! * [`Tri4`]: four triangles tested against one ray at once, bit-identical to the scalar
 //!   Möller–Trumbore test (the wide BVH's leaves, the grid's triangle store).
 //! * [`closest_point_on_triangle`] (Ericson's region test) and [`box_distance_squared`], for
@@ -32,6 +32,7 @@ mod triangle;
 pub mod tribox;
 
 pub use aabb::Aabb;
+mod watertight;
 pub use glam::{DVec3, Vec3};
 pub use mesh::{MeshError, RemovedTriangles, TriangleMesh};
 pub use point::{
@@ -46,6 +47,7 @@ pub use triangle::{MollerTriangle, TriHit, Triangle, TriangleTest};
 /// Largest finite value that still compares correctly: `max` of two floats, ignoring a NaN in
 /// `candidate`. Written as a comparison so it compiles to one `maxss` (NaN in `candidate` keeps
 /// `acc`); used by the slab test where `0 * inf` may produce NaN.
+pub use watertight::WatertightRay;
 #[inline(always)]
 pub fn max_keep(acc: f32, candidate: f32) -> f32 {
     if candidate > acc { candidate } else { acc }

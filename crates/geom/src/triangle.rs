@@ -1,3 +1,4 @@
+use crate::watertight::WatertightRay;
 use crate::{Aabb, Ray};
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
@@ -82,6 +83,30 @@ impl MollerTriangle {
             v: v * inv,
         })
     }
+
+    /// Whether [`intersect`](Self::intersect) finds a hit, by the same operations in the same
+    /// order but without a branch: the sign flip as an `xor` of the sign bit (what negation
+    /// does) and every condition evaluated. A scan over many triangles (brute force) runs this
+    /// first: a ray's outcome against random triangles is a coin toss at every branch of
+    /// `intersect`, and the mispredictions cost more than the arithmetic.
+    #[inline(always)]
+    pub fn hits(&self, ray: &Ray) -> bool {
+        let c = self.v0 - ray.origin();
+        let r = c.cross(ray.dir());
+        let den = self.ng.dot(ray.dir());
+        let abs_den = den.abs();
+        let sign = den.to_bits() & 0x8000_0000;
+        let flip = |x: f32| f32::from_bits(x.to_bits() ^ sign);
+        let u = flip(r.dot(self.e2));
+        let v = flip(r.dot(self.e1));
+        let t = flip(self.ng.dot(c));
+        (den != 0.0)
+            & (u >= 0.0)
+            & (v >= 0.0)
+            & (u + v <= abs_den)
+            & (abs_den * ray.t_min() < t)
+            & (t <= abs_den * ray.t_max())
+    }
 }
 
 /// A double-precision look at where a ray meets a triangle's plane, used to arbitrate disputed
@@ -95,10 +120,12 @@ pub struct PlaneCrossing {
 }
 
 impl Triangle {
+    #[inline]
     pub fn new(v0: Vec3, v1: Vec3, v2: Vec3) -> Triangle {
         Triangle { v0, v1, v2 }
     }
 
+    #[inline]
     pub fn bounds(&self) -> Aabb {
         Aabb {
             min: self.v0.min(self.v1).min(self.v2),
@@ -143,63 +170,11 @@ impl Triangle {
         MollerTriangle::new(self).intersect(ray)
     }
 
-    /// The watertight test of Woop, Benthin and Wald (JCGT 2(1), 2013): shear the triangle into
-    /// ray space (largest direction axis becomes z), evaluate the 2D edge functions, and redo
-    /// them in f64 when one is exactly 0, so two triangles sharing an edge never both miss a ray
-    /// through it. Same depth semantics as [`Triangle::intersect_moller`].
+    /// The watertight test of Woop, Benthin and Wald (JCGT 2(1), 2013); see
+    /// [`WatertightRay::intersect`], which a scan over many triangles sets up once per ray.
     #[inline(always)]
     pub fn intersect_watertight(&self, ray: &Ray) -> Option<TriHit> {
-        let d = ray.dir();
-        let kz = d.abs().max_position();
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let sz = 1.0 / d[kz];
-        let sx = d[kx] * sz;
-        let sy = d[ky] * sz;
-        let a = self.v0 - ray.origin();
-        let b = self.v1 - ray.origin();
-        let c = self.v2 - ray.origin();
-        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
-        let mut u = cx * by - cy * bx;
-        let mut v = ax * cy - ay * cx;
-        let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            let edge = |px: f32, py: f32, qx: f32, qy: f32| {
-                (px as f64 * qy as f64 - py as f64 * qx as f64) as f32
-            };
-            u = edge(cx, cy, bx, by);
-            v = edge(ax, ay, cx, cy);
-            w = edge(bx, by, ax, ay);
-        }
-        let negative = u < 0.0 || v < 0.0 || w < 0.0;
-        let positive = u > 0.0 || v > 0.0 || w > 0.0;
-        if negative && positive {
-            return None;
-        }
-        let det = u + v + w;
-        if !(det != 0.0) {
-            return None;
-        }
-        let t = u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz]);
-        let in_range = if det > 0.0 {
-            det * ray.t_min() < t && t <= det * ray.t_max()
-        } else {
-            det * ray.t_min() > t && t >= det * ray.t_max()
-        };
-        if !in_range {
-            return None;
-        }
-        let inv = 1.0 / det;
-        Some(TriHit {
-            t: t * inv,
-            u: v * inv,
-            v: w * inv,
-        })
+        WatertightRay::new(ray).intersect(self)
     }
 
     /// Where the ray meets the triangle's plane, in f64, with the signed distance to the nearest
@@ -411,6 +386,63 @@ mod tests {
             let hit = a.intersect_watertight(&r).or(b.intersect_watertight(&r));
             assert!(hit.is_some(), "crack at s = {s}");
         }
+    }
+
+    /// `MollerTriangle::hits` is `intersect(..).is_some()` everywhere: random triangles and
+    /// rays (edge and depth tests each failing about half the time), windows that end before,
+    /// at and after the plane, rays through vertices and along edges, degenerate triangles,
+    /// zero and non-finite directions.
+    #[test]
+    fn the_branch_free_moller_test_agrees_with_the_moller_test() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut v = || Vec3::new(next(), next(), next());
+        let mut cases: Vec<(Triangle, Ray)> = Vec::new();
+        for _ in 0..50_000 {
+            let tri = Triangle::new(v(), v(), v());
+            // Aimed near the centroid, so about half the rays pass inside the edges.
+            let o = v() * 3.0;
+            let d = (tri.v0 + tri.v1 + tri.v2) / 3.0 - o + v() * 0.3;
+            let t_min = if cases.len().is_multiple_of(3) {
+                0.5
+            } else {
+                0.0
+            };
+            let t_max = [f32::INFINITY, 1.0, 3.0][cases.len() % 3];
+            cases.push((tri, Ray::new(o, d, t_min, t_max)));
+        }
+        let t = tri();
+        let at = |p: Vec3, d: Vec3, t_max: f32| Ray::new(p - d, d, 0.0, t_max);
+        for p in [t.v0, t.v1, t.v2, (t.v0 + t.v1) * 0.5, (t.v1 + t.v2) * 0.5] {
+            for d in [
+                -Vec3::Z,
+                Vec3::Z,
+                Vec3::X,
+                Vec3::new(0.3, -0.2, -1.0),
+                Vec3::ZERO,
+            ] {
+                for t_max in [0.5, 1.0, f32::INFINITY] {
+                    cases.push((t, at(p, d, t_max)));
+                }
+            }
+            cases.push((t, at(p, Vec3::new(f32::NAN, 0.0, -1.0), 1.0)));
+            cases.push((t, at(p, Vec3::new(f32::INFINITY, 0.0, -1.0), 1.0)));
+        }
+        let collinear = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
+        cases.push((collinear, down(0.5, 0.0)));
+        let mut hits = 0;
+        for (tri, ray) in &cases {
+            let m = MollerTriangle::new(tri);
+            let expected = m.intersect(ray).is_some();
+            assert_eq!(m.hits(ray), expected, "{tri:?} {ray:?}");
+            hits += expected as usize;
+        }
+        assert!(hits > 2_000 && hits < cases.len() / 2, "{hits} hits");
     }
 
     #[test]
