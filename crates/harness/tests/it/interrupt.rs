@@ -25,8 +25,10 @@ fn an_interrupted_run_keeps_its_finished_scenes_and_resumes() {
         .args([
             "--workloads",
             "primary,random",
+            // Enough passes that the second scene is still being timed (a second or more on
+            // one core) when the interrupt arrives, a few milliseconds after its line.
             "--rays",
-            "100000",
+            "30000",
             "--trace-runs",
             "30",
         ])
