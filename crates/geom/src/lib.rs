@@ -23,6 +23,8 @@ mod mesh;
 pub mod packet;
 #[cfg(target_arch = "x86_64")]
 pub mod packet8;
+#[cfg(target_arch = "x86_64")]
+mod packet_walk;
 mod point;
 mod prefetch;
 mod ray;
@@ -30,11 +32,13 @@ pub mod rng;
 pub mod tri4;
 mod triangle;
 pub mod tribox;
+mod watertight;
 
 pub use aabb::Aabb;
-mod watertight;
 pub use glam::{DVec3, Vec3};
 pub use mesh::{MeshError, RemovedTriangles, TriangleMesh};
+#[cfg(target_arch = "x86_64")]
+pub use packet_walk::PacketWalk;
 pub use point::{
     box_distance_squared, closest_point_on_triangle, distance_to_triangle_f64, query_radius_squared,
 };
@@ -43,11 +47,11 @@ pub use ray::{EMBREE_LARGE, Ray, RayError};
 pub use rng::SplitMix64;
 pub use tri4::{NO_PRIM, Tri4, Tri4Hits};
 pub use triangle::{MollerTriangle, TriHit, Triangle, TriangleTest};
+pub use watertight::WatertightRay;
 
 /// Largest finite value that still compares correctly: `max` of two floats, ignoring a NaN in
 /// `candidate`. Written as a comparison so it compiles to one `maxss` (NaN in `candidate` keeps
 /// `acc`); used by the slab test where `0 * inf` may produce NaN.
-pub use watertight::WatertightRay;
 #[inline(always)]
 pub fn max_keep(acc: f32, candidate: f32) -> f32 {
     if candidate > acc { candidate } else { acc }

@@ -34,6 +34,8 @@ use build::Selection;
 use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, PreparedRays, Walk,
 };
+#[cfg(target_arch = "x86_64")]
+use raybench_geom::PacketWalk;
 use raybench_geom::{Aabb, Ray, RayError, Tri4, TriangleMesh, Vec3};
 use serde::Serialize;
 use std::sync::Arc;
@@ -206,25 +208,6 @@ pub struct KdTree {
     /// Set when coherent batches are traced as packets (`packets` and AVX2 detected).
     #[cfg(target_arch = "x86_64")]
     coherent: Option<PacketWalk>,
-}
-
-/// Which packet walk traces coherent batches: sixteen rays a packet on AVX-512F, eight on AVX2.
-#[cfg(target_arch = "x86_64")]
-#[derive(Clone, Copy, Debug)]
-enum PacketWalk {
-    Avx512(raybench_geom::packet::Avx512Packets),
-    Avx2(raybench_geom::packet8::Avx2Packets),
-}
-
-#[cfg(target_arch = "x86_64")]
-impl PacketWalk {
-    /// The widest walk this CPU runs.
-    fn detect() -> Option<PacketWalk> {
-        use raybench_geom::{packet::Avx512Packets, packet8::Avx2Packets};
-        Avx512Packets::detect()
-            .map(PacketWalk::Avx512)
-            .or_else(|| Avx2Packets::detect().map(PacketWalk::Avx2))
-    }
 }
 
 impl KdTree {
@@ -405,7 +388,7 @@ impl KdTree {
             mesh: mesh.clone(),
             zero_area: None,
             #[cfg(target_arch = "x86_64")]
-            coherent: params.packets.then(PacketWalk::detect).flatten(),
+            coherent: params.packets.then(|| PacketWalk::detect(true)).flatten(),
         })
     }
 }

@@ -240,8 +240,9 @@ fn walk<const ANY_HIT: bool>(
 
 #[cfg(test)]
 mod tests {
-    use crate::{KdParams, KdTree, PacketWalk};
+    use crate::{KdParams, KdTree};
     use raybench_accel::Accel;
+    use raybench_geom::PacketWalk;
     use raybench_geom::TriangleMesh;
     use raybench_geom::packet8::Avx2Packets;
     use raybench_testkit::{

@@ -71,6 +71,8 @@ use pack::{fill_tri4s, number_tri4s};
 use raybench_accel::{
     Accel, BuildError, BuildStats, CounterSink, Hit, Memory, NoCount, PreparedRays, Walk,
 };
+#[cfg(target_arch = "x86_64")]
+use raybench_geom::PacketWalk;
 use raybench_geom::{Aabb, Ray, RayError, Tri4, TriangleMesh, Vec3};
 use std::sync::Arc;
 
@@ -99,30 +101,6 @@ pub struct BvhWide<const W: usize> {
     coherent: Option<PacketWalk>,
     /// What the reinsertion optimizer did to the binary tree, when it ran.
     reinsertion: Option<crate::ReinsertStats>,
-}
-
-/// Which packet walk traces coherent batches: sixteen rays a packet on AVX-512F, eight on AVX2.
-#[cfg(target_arch = "x86_64")]
-#[derive(Clone, Copy, Debug)]
-enum PacketWalk {
-    Avx512(raybench_geom::packet::Avx512Packets),
-    Avx2(raybench_geom::packet8::Avx2Packets),
-}
-
-#[cfg(target_arch = "x86_64")]
-impl PacketWalk {
-    /// The widest walk this CPU runs; eight lanes where the node kernels are held to AVX2
-    /// (`NodeSimd::Avx2`), so a CPU with AVX-512 can run and test the AVX2 walk too.
-    fn detect(node_simd: NodeSimd) -> Option<PacketWalk> {
-        use raybench_geom::{packet::Avx512Packets, packet8::Avx2Packets};
-        let avx512 = match node_simd {
-            NodeSimd::Avx2 => None,
-            NodeSimd::Auto | NodeSimd::Sse => Avx512Packets::detect(),
-        };
-        avx512
-            .map(PacketWalk::Avx512)
-            .or_else(|| Avx2Packets::detect().map(PacketWalk::Avx2))
-    }
 }
 
 /// 8 children per node, tested in one AVX2 pass per axis: the structure that races Embree.
@@ -181,10 +159,7 @@ impl<const W: usize> BvhWide<W> {
     /// 8 with AVX2 alone or `NodeSimd::Avx2`.
     pub fn packet_lanes(&self) -> Option<usize> {
         #[cfg(target_arch = "x86_64")]
-        return self.coherent.map(|walk| match walk {
-            PacketWalk::Avx512(_) => raybench_geom::packet::PACKET,
-            PacketWalk::Avx2(_) => raybench_geom::packet8::LANES,
-        });
+        return self.coherent.map(PacketWalk::lanes);
         #[cfg(not(target_arch = "x86_64"))]
         None
     }
@@ -254,7 +229,9 @@ impl<const W: usize> Accel for BvhWide<W> {
             #[cfg(target_arch = "x86_64")]
             coherent: params
                 .coherent_packets
-                .then(|| PacketWalk::detect(params.node_simd))
+                // Eight lanes where the node kernels are held to AVX2, so that an AVX-512 CPU
+                // runs (and tests) the AVX2 walk too.
+                .then(|| PacketWalk::detect(params.node_simd != NodeSimd::Avx2))
                 .flatten(),
             reinsertion,
         })
