@@ -330,13 +330,8 @@ mod tests {
     /// last block is partial.
     #[test]
     fn the_blocked_scan_answers_and_counts_as_one_triangle_at_a_time() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = raybench_geom::SplitMix64::new(0x2545_f491_4f6c_dd1d);
+        let mut next = move || rng.unit();
         let mut v = || Vec3::new(next(), next(), next());
         let mut tris: Vec<Triangle> = (0..1_000)
             .map(|_| {
@@ -395,13 +390,8 @@ mod tests {
     /// far from them, at an infinite radius and a small one, with repeated triangles (ties).
     #[test]
     fn the_closest_point_scan_answers_as_testing_every_triangle() {
-        let mut state = 0x853c_49e6_748f_ea9bu64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = raybench_geom::SplitMix64::new(0x853c_49e6_748f_ea9b);
+        let mut next = move || rng.unit();
         let mut found_some = false;
         for (scale, offset) in [(1.0, 0.0), (1e-15, 0.0), (1.0, 1e6)] {
             let mut v = || Vec3::new(next(), next(), next());
