@@ -51,19 +51,13 @@ fn intersect_packets(
     out: &mut [Option<Hit>],
     stack: &mut PacketStack,
 ) {
-    for ((block, out), rays) in blocks
-        .iter()
-        .zip(out.chunks_mut(PACKET))
-        .zip(rays.chunks(PACKET))
-    {
-        for (half, (out, rays)) in out.chunks_mut(LANES).zip(rays.chunks(LANES)).enumerate() {
-            let (p, mut best) = packet8::load(block, half);
-            walk_packet::<false>(kd, &p, rays, out.len(), &mut best, stack);
-            for (o, (prim, h)) in out.iter_mut().zip(best.hits()) {
-                *o = (prim != NO_PRIM).then(|| Hit::from_tri_hit(prim, h));
-            }
+    each_packet(rays, blocks, out, |block, half, rays, out| {
+        let (p, mut best) = packet8::load(block, half);
+        walk_packet::<false>(kd, &p, rays, out.len(), &mut best, stack);
+        for (o, (prim, h)) in out.iter_mut().zip(best.hits()) {
+            *o = (prim != NO_PRIM).then(|| Hit::from_tri_hit(prim, h));
         }
-    }
+    });
 }
 
 /// Traces a coherent batch (any hit), as [`intersect_coherent`].
@@ -88,17 +82,31 @@ fn occluded_packets(
     out: &mut [bool],
     stack: &mut PacketStack,
 ) {
+    each_packet(rays, blocks, out, |block, half, rays, out| {
+        let (p, mut best) = packet8::load(block, half);
+        let done = walk_packet::<true>(kd, &p, rays, out.len(), &mut best, stack);
+        for (lane, o) in out.iter_mut().enumerate() {
+            *o = done >> lane & 1 == 1;
+        }
+    });
+}
+
+/// Each block's two packets of eight: `packet` gets the block, which half, that half's rays
+/// and their outputs (fewer than eight in a batch's last block).
+#[inline(always)]
+fn each_packet<T>(
+    rays: &[Ray],
+    blocks: &[RayBlock],
+    out: &mut [T],
+    mut packet: impl FnMut(&RayBlock, usize, &[Ray], &mut [T]),
+) {
     for ((block, out), rays) in blocks
         .iter()
         .zip(out.chunks_mut(PACKET))
         .zip(rays.chunks(PACKET))
     {
         for (half, (out, rays)) in out.chunks_mut(LANES).zip(rays.chunks(LANES)).enumerate() {
-            let (p, mut best) = packet8::load(block, half);
-            let done = walk_packet::<true>(kd, &p, rays, out.len(), &mut best, stack);
-            for (lane, o) in out.iter_mut().enumerate() {
-                *o = done >> lane & 1 == 1;
-            }
+            packet(block, half, rays, out);
         }
     }
 }
