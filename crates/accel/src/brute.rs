@@ -2,14 +2,14 @@
 //! no build, no cleverness — which is the point: it is the oracle the other structures are
 //! checked against. Ties (equal t, or equal distance for closest-point queries) resolve to the
 //! lowest primitive index. Concessions to speed that change no answer and no counter: a ray
-//! scan tests blocks of triangles without branches first (the same arithmetic, for Möller–
-//! Trumbore and the watertight test alike) and runs the test that decides only on the
-//! triangles that passed; the closest-point scan skips triangles whose boxes are clearly
-//! farther than the best so far.
+//! scan tests blocks of triangles without branches first (the same arithmetic: for Möller–
+//! Trumbore the four-lane [`Tri4::test`], for the watertight test its candidate test) and runs
+//! the scalar test that decides only on the triangles that passed; the closest-point scan skips
+//! triangles whose boxes are clearly farther than the best so far.
 
 use crate::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, Nearest, PointHit};
 use raybench_geom::{
-    MollerTriangle, Ray, TriHit, Triangle, TriangleMesh, TriangleTest, Vec3, WatertightRay,
+    MollerTriangle, Ray, Tri4, TriHit, Triangle, TriangleMesh, TriangleTest, Vec3, WatertightRay,
     box_distance_squared,
 };
 use serde::Serialize;
@@ -32,76 +32,151 @@ pub struct BruteForce {
     extent: f32,
 }
 
-/// Triangles in the layout their test wants: Möller–Trumbore reads Embree's precomputed
-/// `v0, e1, e2, Ng`; the watertight test reads the vertices.
+/// Triangles in the layout their test wants: Möller–Trumbore reads Embree's `v0, e1, e2` four
+/// triangles to a [`Tri4`] (lane by lane, so the candidate test runs on four at once), in mesh
+/// order, the last one's unused lanes empty; the watertight test reads the vertices.
 #[derive(Debug)]
 enum Triangles {
-    Moller(Vec<MollerTriangle>),
+    Moller { tri4s: Vec<Tri4>, len: usize },
     Vertices(Vec<Triangle>),
 }
 
+/// Triangles a tile of [`BruteForce::intersect_all`] holds: 192 KB of `Tri4`s (144 KB of
+/// vertices), which stay in a core's L2 while every ray is scanned over them. A multiple of
+/// both scans' blocks, so each ray's blocks (and their windows) are the ones a scan of the
+/// whole mesh has.
+const TILE: usize = 4096;
+
 impl BruteForce {
     fn trace<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        let mut s = Scan::new(ray);
+        let first_hit = match &self.triangles {
+            Triangles::Moller { tri4s, .. } => moller_blocks::<ANY_HIT>(tri4s, 0, &mut s),
+            Triangles::Vertices(t) => {
+                vertex_blocks::<ANY_HIT>(t, 0, &WatertightRay::new(ray), &mut s)
+            }
+        };
+        // Counted as the one-by-one loop counts: every triangle, or up to the first hit.
+        c.prim_tests(first_hit.map_or(self.len(), |prim| prim + 1) as u64);
+        s.best
+    }
+
+    /// Every ray's closest hit, exactly as [`Accel::intersect`] answers it ray by ray (each
+    /// ray meets the triangles in the same order, in the same blocks), scanned a tile of
+    /// triangles at a time across all the rays: a mesh larger than the cache is then read
+    /// from memory once a tile instead of once a ray. For oracles checking many rays.
+    pub fn intersect_all(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
+        let mut scans: Vec<Scan> = rays.iter().map(Scan::new).collect();
         match &self.triangles {
-            Triangles::Moller(t) => {
-                scan::<ANY_HIT, _, _>(t, ray, c, MollerTriangle::hits, MollerTriangle::intersect)
+            Triangles::Moller { tri4s, .. } => {
+                for (k, tile) in tri4s.chunks(TILE / 4).enumerate() {
+                    for s in &mut scans {
+                        moller_blocks::<false>(tile, k * TILE / 4, s);
+                    }
+                }
             }
             Triangles::Vertices(t) => {
-                let w = WatertightRay::new(ray);
-                scan::<ANY_HIT, _, _>(
-                    t,
-                    ray,
-                    c,
-                    |t, r| w.with_window_of(r).may_hit(t),
-                    |t, r| w.with_window_of(r).intersect(t),
-                )
+                let set_up: Vec<WatertightRay> = rays.iter().map(WatertightRay::new).collect();
+                for (k, tile) in t.chunks(TILE).enumerate() {
+                    for (s, w) in scans.iter_mut().zip(&set_up) {
+                        vertex_blocks::<false>(tile, k * TILE, w, s);
+                    }
+                }
             }
         }
+        scans.into_iter().map(|s| s.best).collect()
     }
 }
 
-/// The one loop: every triangle, keeping the closest hit (the lowest index on equal t), or
-/// stopping at the first hit for any-hit queries. `test` decides every answer; `may_hit`, a
-/// test that never says no where `test` would hit, is run first on blocks of triangles, so
-/// that `test` (whose branches a scan mispredicts) runs only where it can hit.
+/// One ray's scan in progress: its closest hit so far and its window narrowed to it.
+#[derive(Clone, Copy)]
+struct Scan {
+    best: Option<Hit>,
+    ray: Ray,
+}
+
+impl Scan {
+    fn new(ray: &Ray) -> Scan {
+        Scan {
+            best: None,
+            ray: *ray,
+        }
+    }
+
+    /// Keeps triangle `prim`'s hit `h` if it is nearer than the best so far (on equal t the
+    /// lower index, met first, stays); whether it was kept.
+    #[inline(always)]
+    fn offer(&mut self, prim: usize, h: TriHit) -> bool {
+        if self.best.is_some_and(|b| h.t >= b.t) {
+            return false;
+        }
+        self.best = Some(Hit::from_tri_hit(prim as u32, h));
+        self.ray = self.ray.with_t_max(h.t);
+        true
+    }
+}
+
+/// The one loop over the vertices (`tris`, the first of them triangle `first`): every
+/// triangle, keeping the closest hit, or stopping at the first hit for any-hit queries (its
+/// index returned). The watertight test decides every answer; its candidate test, which never
+/// says no where the test would hit, is run first on blocks of triangles, so that the test
+/// (whose branches a scan mispredicts) runs only where it can hit.
 #[inline(always)]
-fn scan<const ANY_HIT: bool, T, C: CounterSink>(
-    tris: &[T],
-    ray: &Ray,
-    c: &mut C,
-    may_hit: impl Fn(&T, &Ray) -> bool,
-    test: impl Fn(&T, &Ray) -> Option<TriHit>,
-) -> Option<Hit> {
+fn vertex_blocks<const ANY_HIT: bool>(
+    tris: &[Triangle],
+    first: usize,
+    w: &WatertightRay,
+    s: &mut Scan,
+) -> Option<usize> {
     const BLOCK: usize = 32;
-    let mut best: Option<Hit> = None;
-    let mut r = *ray;
     for (b, block) in tris.chunks(BLOCK).enumerate() {
         // Every triangle of the block against the window at its start: a later hit only
-        // narrows it, so this never drops a triangle `test` would hit.
+        // narrows it, so this never drops a triangle the test would hit.
+        let window = w.with_window_of(&s.ray);
         let mut candidates = 0u32;
         for (i, tri) in block.iter().enumerate() {
-            candidates |= (may_hit(tri, &r) as u32) << i;
+            candidates |= (window.may_hit(tri) as u32) << i;
         }
         while candidates != 0 {
             let i = candidates.trailing_zeros() as usize;
             candidates &= candidates - 1;
-            let Some(h) = test(&block[i], &r) else {
-                continue;
-            };
-            if best.is_some_and(|b| h.t >= b.t) {
-                continue; // equal t: keep the lower primitive index
+            let prim = first + b * BLOCK + i;
+            if let Some(h) = w.with_window_of(&s.ray).intersect(&block[i])
+                && s.offer(prim, h)
+                && ANY_HIT
+            {
+                return Some(prim);
             }
-            best = Some(Hit::from_tri_hit((b * BLOCK + i) as u32, h));
-            if ANY_HIT {
-                // Counted as the one-by-one loop counts: up to the first hit.
-                c.prim_tests((b * BLOCK + i + 1) as u64);
-                return best;
-            }
-            r = r.with_t_max(h.t);
         }
     }
-    c.prim_tests(tris.len() as u64);
-    best
+    None
+}
+
+/// [`vertex_blocks`] for Möller–Trumbore over [`Tri4`]s (the first of them `Tri4` `first`):
+/// blocks of eight `Tri4`s, each tested on its four lanes at once against the window at the
+/// block's start ([`Tri4::test`], bit for bit the scalar test), then the scalar test on each
+/// lane that hit, a lane rebuilt as the [`MollerTriangle`] it was packed from.
+#[inline(always)]
+fn moller_blocks<const ANY_HIT: bool>(tri4s: &[Tri4], first: usize, s: &mut Scan) -> Option<usize> {
+    const BLOCK: usize = 8;
+    for (b, block) in tri4s.chunks(BLOCK).enumerate() {
+        let mut candidates = 0u32;
+        for (k, tri4) in block.iter().enumerate() {
+            candidates |= tri4.test(&s.ray, s.ray.t_max()).mask << (4 * k);
+        }
+        while candidates != 0 {
+            let i = candidates.trailing_zeros() as usize;
+            candidates &= candidates - 1;
+            let prim = (first + b * BLOCK) * 4 + i;
+            if let Some(h) = block[i / 4].lane(i % 4).intersect(&s.ray)
+                && s.offer(prim, h)
+                && ANY_HIT
+            {
+                return Some(prim);
+            }
+        }
+    }
+    None
 }
 
 /// The closest-point scan: every triangle's exact closest point, keeping the nearest within
@@ -136,7 +211,7 @@ fn closest_point_scan<C: CounterSink>(
 impl BruteForce {
     fn len(&self) -> usize {
         match &self.triangles {
-            Triangles::Moller(t) => t.len(),
+            Triangles::Moller { len, .. } => *len,
             Triangles::Vertices(t) => t.len(),
         }
     }
@@ -152,7 +227,15 @@ impl Accel for BruteForce {
         };
         let triangles = match params.triangle_test {
             TriangleTest::MollerTrumbore => {
-                Triangles::Moller(mesh.triangles().map(|t| MollerTriangle::new(&t)).collect())
+                let tris: Vec<(u32, MollerTriangle)> = mesh
+                    .triangles()
+                    .enumerate()
+                    .map(|(i, t)| (i as u32, MollerTriangle::new(&t)))
+                    .collect();
+                Triangles::Moller {
+                    tri4s: tris.chunks(4).map(Tri4::pack).collect(),
+                    len: tris.len(),
+                }
             }
             TriangleTest::Watertight => Triangles::Vertices(mesh.triangles().collect()),
         };
@@ -187,7 +270,7 @@ impl Accel for BruteForce {
 
     fn memory(&self) -> Memory {
         let bytes = match &self.triangles {
-            Triangles::Moller(t) => std::mem::size_of_val(t.as_slice()),
+            Triangles::Moller { tri4s, .. } => std::mem::size_of_val(tri4s.as_slice()),
             Triangles::Vertices(t) => std::mem::size_of_val(t.as_slice()),
         };
         Memory {
@@ -383,6 +466,48 @@ mod tests {
             }
         }
         assert!(hit > 500 && missed > 500, "{hit} hits, {missed} misses");
+    }
+
+    /// `intersect_all` answers every ray as `intersect` does, for both triangle tests, on a
+    /// mesh of three tiles (the last partial) with triangles repeated across a tile boundary
+    /// (ties, the earlier index winning) and windows ending short of some hits.
+    #[test]
+    fn every_ray_at_once_answers_as_ray_by_ray() {
+        let mut rng = raybench_geom::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = move || rng.unit();
+        let mut v = || Vec3::new(next(), next(), next());
+        let mut tris: Vec<Triangle> = (0..2 * TILE + 900)
+            .map(|_| {
+                let c = v() * 8.0;
+                Triangle::new(c + v() - Vec3::splat(0.5), c + v(), c - v())
+            })
+            .collect();
+        tris.extend_from_within(TILE - 20..TILE + 20);
+        let mesh = Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0);
+        let rays: Vec<Ray> = (0..600)
+            .map(|i| {
+                let o = v() * 10.0 - Vec3::ONE;
+                let d = if i % 2 == 0 {
+                    v() - Vec3::splat(0.5)
+                } else {
+                    mesh.triangle(TILE - 20 + i % 40).centroid() - o
+                };
+                Ray::new(o, d, 0.0, if i % 3 == 0 { 0.9 } else { f32::INFINITY })
+            })
+            .collect();
+        for triangle_test in [TriangleTest::MollerTrumbore, TriangleTest::Watertight] {
+            let bf = BruteForce::build(mesh.clone(), &BruteForceParams { triangle_test }).unwrap();
+            let one_by_one: Vec<_> = rays.iter().map(|r| bf.intersect(r)).collect();
+            assert_eq!(bf.intersect_all(&rays), one_by_one, "{triangle_test:?}");
+            let hits: Vec<u32> = one_by_one.iter().flatten().map(|h| h.prim).collect();
+            assert!(hits.len() > 200, "{triangle_test:?}: {} hits", hits.len());
+            // Rays aimed at the repeated triangles hit the first copy, before the boundary.
+            assert!(
+                hits.iter()
+                    .any(|&p| (TILE as u32 - 20..TILE as u32).contains(&p))
+            );
+            assert!(hits.iter().all(|&p| p < 2 * TILE as u32 + 900));
+        }
     }
 
     /// The closest-point scan with its box skip answers as testing every triangle does, at

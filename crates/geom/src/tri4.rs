@@ -268,6 +268,29 @@ mod tests {
         );
     }
 
+    /// On the scalar test's edge cases (rays through vertices and edges, zero and non-finite
+    /// directions, windows ending at the plane, a degenerate triangle), a triangle in lane 0
+    /// hits exactly where the scalar test does, and the three unused lanes never hit.
+    #[test]
+    fn one_lane_answers_the_edge_cases_as_the_scalar_test() {
+        let cases = crate::triangle::tests::random_and_edge_cases();
+        let mut hits = 0;
+        for (tri, ray) in &cases {
+            let m = MollerTriangle::new(tri);
+            let want = m.intersect(ray);
+            let have = Tri4::pack(&[(0, m)]).test(ray, ray.t_max());
+            let bits = |h: TriHit| [h.t, h.u, h.v].map(f32::to_bits);
+            assert_eq!(have.mask >> 1, 0, "an unused lane hit: {tri:?} {ray:?}");
+            assert_eq!(
+                (have.mask == 1).then(|| bits(have.get(0))),
+                want.map(bits),
+                "{tri:?} {ray:?}"
+            );
+            hits += want.is_some() as usize;
+        }
+        assert!(hits > 2_000 && hits < cases.len() / 2, "{hits} hits");
+    }
+
     #[test]
     fn unused_lanes_never_hit() {
         let empty = Tri4::default();

@@ -83,30 +83,6 @@ impl MollerTriangle {
             v: v * inv,
         })
     }
-
-    /// Whether [`intersect`](Self::intersect) finds a hit, by the same operations in the same
-    /// order but without a branch: the sign flip as an `xor` of the sign bit (what negation
-    /// does) and every condition evaluated. A scan over many triangles (brute force) runs this
-    /// first: a ray's outcome against random triangles is a coin toss at every branch of
-    /// `intersect`, and the mispredictions cost more than the arithmetic.
-    #[inline(always)]
-    pub fn hits(&self, ray: &Ray) -> bool {
-        let c = self.v0 - ray.origin();
-        let r = c.cross(ray.dir());
-        let den = self.ng.dot(ray.dir());
-        let abs_den = den.abs();
-        let sign = den.to_bits() & 0x8000_0000;
-        let flip = |x: f32| f32::from_bits(x.to_bits() ^ sign);
-        let u = flip(r.dot(self.e2));
-        let v = flip(r.dot(self.e1));
-        let t = flip(self.ng.dot(c));
-        (den != 0.0)
-            & (u >= 0.0)
-            & (v >= 0.0)
-            & (u + v <= abs_den)
-            & (abs_den * ray.t_min() < t)
-            & (t <= abs_den * ray.t_max())
-    }
 }
 
 /// A double-precision look at where a ray meets a triangle's plane, used to arbitrate disputed
@@ -431,20 +407,6 @@ pub(crate) mod tests {
         let collinear = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
         cases.push((collinear, down(0.5, 0.0)));
         cases
-    }
-
-    /// `MollerTriangle::hits` is `intersect(..).is_some()` on every case.
-    #[test]
-    fn the_branch_free_moller_test_agrees_with_the_moller_test() {
-        let cases = random_and_edge_cases();
-        let mut hits = 0;
-        for (tri, ray) in &cases {
-            let m = MollerTriangle::new(tri);
-            let expected = m.intersect(ray).is_some();
-            assert_eq!(m.hits(ray), expected, "{tri:?} {ray:?}");
-            hits += expected as usize;
-        }
-        assert!(hits > 2_000 && hits < cases.len() / 2, "{hits} hits");
     }
 
     #[test]

@@ -44,13 +44,14 @@ use structure::Checker;
 pub const REFERENCES: [&str; 3] = ["embree-medium", "embree-robust", "bruteforce"];
 
 /// Ray–triangle tests brute force may spend per scene × workload (per brute-force pass):
-/// about a tenth of a second of one core for `bruteforce` at the 2.0e8 Möller–Trumbore tests
-/// per second measured, a third for `bruteforce-watertight` at 5.9e7 (release build,
-/// `soup:triangles=10000`, 20,000 random rays, on the shared 2-core development machine, an
-/// AMD EPYC with AVX2). A scene × workload costs five such passes (the reference, and the
-/// timed and counted paths of `bruteforce` and `bruteforce-watertight`), so the adversarial
-/// suite verifies in about two minutes on 2 cores, most of them the structures' own. At 5,000 rays every scene up to 4,000 triangles is
-/// checked on every ray; `--brute-force-budget 2e8` checks ten times as many.
+/// well under a tenth of a second of one core for `bruteforce` at the 2.8e8–3.8e8
+/// Möller–Trumbore tests per second measured, a third of a second for `bruteforce-watertight`
+/// at 5e7–7.8e7 (release build, `soup:triangles=10000` and `sphere:triangles=100000`, random
+/// and camera rays, on the shared 2-core development machine, an AMD EPYC with AVX2). A scene
+/// × workload costs five such passes (the reference, and the timed and counted paths of
+/// `bruteforce` and `bruteforce-watertight`), so the adversarial suite verifies in about two
+/// minutes on 2 cores, most of them the structures' own. At 5,000 rays every scene up to 4,000
+/// triangles is checked on every ray; `--brute-force-budget 2e8` checks ten times as many.
 pub const BRUTE_FORCE_BUDGET: u64 = 20_000_000;
 
 /// Everything `raybench verify` needs; the CLI fills it from flags and the suite manifest.
