@@ -47,7 +47,7 @@ pub use ray::{EMBREE_LARGE, Ray, RayError};
 pub use rng::SplitMix64;
 pub use tri4::{NO_PRIM, Tri4, Tri4Hits};
 pub use triangle::{MollerTriangle, TriHit, Triangle, TriangleTest};
-pub use watertight::WatertightRay;
+pub use watertight::{Vertices4, WatertightRay};
 
 /// Largest finite value that still compares correctly: `max` of two floats, ignoring a NaN in
 /// `candidate`. Written as a comparison so it compiles to one `maxss` (NaN in `candidate` keeps

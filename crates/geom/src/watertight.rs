@@ -113,25 +113,89 @@ impl WatertightRay {
         })
     }
 
-    /// False only where [`intersect`](Self::intersect) misses, computed without a branch: the
-    /// same f32 edge functions and depth test, and true wherever an edge function is exactly
-    /// 0 (where `intersect` redoes them in f64). A scan runs this first on blocks of triangles,
-    /// and `intersect` only where it says true.
+    /// [`shear_one`](Self::shear_one)'s operations on the four lanes of one vertex
+    /// (`vertex[axis][lane]`): `(v - origin)` read on the permuted axes, sheared.
     #[inline(always)]
-    pub fn may_hit(&self, tri: &Triangle) -> bool {
-        let [(ax, ay, az), (bx, by, bz), (cx, cy, cz)] = self.shear(tri);
+    fn shear4(&self, vertex: &[[f32; 4]; 3]) -> [[f32; 4]; 3] {
+        let [kx, ky, kz] = self.k;
+        let [sx, sy, _] = self.s;
+        let (ox, oy, oz) = (self.origin[kx], self.origin[ky], self.origin[kz]);
+        let (vx, vy, vz) = (&vertex[kx], &vertex[ky], &vertex[kz]);
+        let mut out = [[0.0f32; 4]; 3];
+        for l in 0..4 {
+            let pz = vz[l] - oz;
+            out[0][l] = (vx[l] - ox) - sx * pz;
+            out[1][l] = (vy[l] - oy) - sy * pz;
+            out[2][l] = pz;
+        }
+        out
+    }
+
+    /// For each of the four lanes of `tris`, false only where [`intersect`](Self::intersect)
+    /// misses that triangle (bit `l` of the result for lane `l`), computed without a branch:
+    /// the same f32 shear, edge functions and depth test lane for lane, and true wherever an
+    /// edge function is exactly 0 (where `intersect` redoes them in f64). A scan runs this
+    /// first on blocks of triangles, and `intersect` only where it says true. Unused (zero)
+    /// lanes may say true: the caller masks them.
+    #[inline(always)]
+    pub fn may_hit4(&self, tris: &Vertices4) -> u32 {
         let sz = self.s[2];
-        let u = cx * by - cy * bx;
-        let v = ax * cy - ay * cx;
-        let w = bx * ay - by * ax;
-        let on_an_edge = (u == 0.0) | (v == 0.0) | (w == 0.0);
-        let negative = (u < 0.0) | (v < 0.0) | (w < 0.0);
-        let positive = (u > 0.0) | (v > 0.0) | (w > 0.0);
-        let det = u + v + w;
-        let t = u * (sz * az) + v * (sz * bz) + w * (sz * cz);
-        let front = (det > 0.0) & (det * self.t_min < t) & (t <= det * self.t_max);
-        let back = (det < 0.0) & (det * self.t_min > t) & (t >= det * self.t_max);
-        on_an_edge | (!(negative & positive) & (front | back))
+        let [a, b, c] = [
+            self.shear4(&tris.v[0]),
+            self.shear4(&tris.v[1]),
+            self.shear4(&tris.v[2]),
+        ];
+        let mut may = [false; 4];
+        #[allow(clippy::needless_range_loop)] // lane loops, written for the vectoriser
+        for l in 0..4 {
+            let (ax, ay, az) = (a[0][l], a[1][l], a[2][l]);
+            let (bx, by, bz) = (b[0][l], b[1][l], b[2][l]);
+            let (cx, cy, cz) = (c[0][l], c[1][l], c[2][l]);
+            let u = cx * by - cy * bx;
+            let v = ax * cy - ay * cx;
+            let w = bx * ay - by * ax;
+            let on_an_edge = (u == 0.0) | (v == 0.0) | (w == 0.0);
+            let negative = (u < 0.0) | (v < 0.0) | (w < 0.0);
+            let positive = (u > 0.0) | (v > 0.0) | (w > 0.0);
+            let det = u + v + w;
+            let t = u * (sz * az) + v * (sz * bz) + w * (sz * cz);
+            let front = (det > 0.0) & (det * self.t_min < t) & (t <= det * self.t_max);
+            let back = (det < 0.0) & (det * self.t_min > t) & (t >= det * self.t_max);
+            may[l] = on_an_edge | (!(negative & positive) & (front | back));
+        }
+        may.iter()
+            .enumerate()
+            .fold(0, |m, (l, &b)| m | (b as u32) << l)
+    }
+}
+
+/// Four triangles' vertices lane by lane (`v[vertex][axis][lane]`), for the watertight
+/// candidate test on four at once ([`WatertightRay::may_hit4`]); unused lanes are zero.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Vertices4 {
+    pub v: [[[f32; 4]; 3]; 3],
+}
+
+impl Vertices4 {
+    /// Packs up to four triangles into lanes 0, 1, …
+    pub fn pack(tris: &[Triangle]) -> Vertices4 {
+        assert!(tris.len() <= 4, "a Vertices4 holds at most four triangles");
+        let mut p = Vertices4::default();
+        for (l, t) in tris.iter().enumerate() {
+            for (j, vertex) in [t.v0, t.v1, t.v2].into_iter().enumerate() {
+                for axis in 0..3 {
+                    p.v[j][axis][l] = vertex[axis];
+                }
+            }
+        }
+        p
+    }
+
+    /// Lane `l` as a triangle.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> Triangle {
+        let [a, b, c] = self.v.map(|v| Vec3::new(v[0][l], v[1][l], v[2][l]));
+        Triangle::new(a, b, c)
     }
 }
 
@@ -139,9 +203,9 @@ impl WatertightRay {
 mod tests {
     use super::*;
 
-    /// `may_hit` is false only where `intersect` misses, and `intersect` through a set-up ray
+    /// `may_hit4` is false only where `intersect` misses, and `intersect` through a set-up ray
     /// is `Triangle::intersect_watertight`, on the Möller test's random and edge cases. None of
-    /// them needs `may_hit`'s clause for an edge function of exactly 0 (a redo in f64 that
+    /// them needs `may_hit4`'s clause for an edge function of exactly 0 (a redo in f64 that
     /// turns mixed signs into one sign is rare: none in 400,000 rays aimed at random triangles'
     /// vertices); it stays, since the redo may change all three signs.
     #[test]
@@ -153,9 +217,20 @@ mod tests {
             let hit = w.intersect(tri);
             let bits = |h: Option<TriHit>| h.map(|h| [h.t, h.u, h.v].map(f32::to_bits));
             assert_eq!(bits(hit), bits(tri.intersect_watertight(ray)));
-            assert!(w.may_hit(tri) || hit.is_none(), "{tri:?} {ray:?}");
+            let may_hit = w.may_hit4(&Vertices4::pack(&[*tri])) & 1 != 0;
+            assert!(may_hit || hit.is_none(), "{tri:?} {ray:?}");
+            assert_eq!(Vertices4::pack(&[*tri]).lane(0), *tri);
             hits += hit.is_some() as usize;
-            rejected += !w.may_hit(tri) as usize;
+            rejected += !may_hit as usize;
+        }
+        // Four triangles in one pack answer lane by lane as each alone.
+        for group in cases.chunks_exact(4) {
+            let tris: Vec<Triangle> = group.iter().map(|(t, _)| *t).collect();
+            let w = WatertightRay::new(&group[0].1);
+            let alone = tris.iter().enumerate().fold(0, |m, (l, t)| {
+                m | (w.may_hit4(&Vertices4::pack(&[*t])) & 1) << l
+            });
+            assert_eq!(w.may_hit4(&Vertices4::pack(&tris)), alone);
         }
         // Both outcomes are common, and the candidate test rejects most misses.
         assert!(

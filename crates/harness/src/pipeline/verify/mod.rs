@@ -46,7 +46,7 @@ pub const REFERENCES: [&str; 3] = ["embree-medium", "embree-robust", "bruteforce
 /// Ray–triangle tests brute force may spend per scene × workload (per brute-force pass):
 /// well under a tenth of a second of one core for `bruteforce` at the 2.8e8–3.8e8
 /// Möller–Trumbore tests per second measured, a third of a second for `bruteforce-watertight`
-/// at 5e7–7.8e7 (release build, `soup:triangles=10000` and `sphere:triangles=100000`, random
+/// at 6e7–9e7 (release build, `soup:triangles=10000` and `sphere:triangles=100000`, random
 /// and camera rays, on the shared 2-core development machine, an AMD EPYC with AVX2). A scene
 /// × workload costs five such passes (the reference, and the timed and counted paths of
 /// `bruteforce` and `bruteforce-watertight`), so the adversarial suite verifies in about two
