@@ -73,28 +73,28 @@ impl BruteForce {
     /// from memory once a tile instead of once a ray. For oracles checking many rays.
     pub fn intersect_all(&self, rays: &[Ray]) -> Vec<Option<Hit>> {
         let mut scans: Vec<Scan> = rays.iter().map(Scan::new).collect();
-        const PACKS: usize = TILE / 4;
         match &self.triangles {
-            Triangles::Moller(packs) => {
-                for (k, tile) in packs.chunks(PACKS).enumerate() {
-                    for s in &mut scans {
-                        blocks::<false, _>(&Moller, tile, k * TILE, self.len, s);
-                    }
-                }
-            }
-            Triangles::Vertices(packs) => {
-                let set_up: Vec<Watertight> = rays
-                    .iter()
-                    .map(|r| Watertight(WatertightRay::new(r)))
-                    .collect();
-                for (k, tile) in packs.chunks(PACKS).enumerate() {
-                    for (s, w) in scans.iter_mut().zip(&set_up) {
-                        blocks::<false, _>(w, tile, k * TILE, self.len, s);
-                    }
-                }
-            }
+            Triangles::Moller(packs) => by_tiles(packs, self.len, &mut scans, |_| Moller),
+            Triangles::Vertices(packs) => by_tiles(packs, self.len, &mut scans, |r| {
+                Watertight(WatertightRay::new(r))
+            }),
         }
         scans.into_iter().map(|s| s.best).collect()
+    }
+}
+
+/// Every scan over `packs` (the whole mesh, `len` triangles) a tile at a time, each ray with
+/// the test `test_for` sets up for it (a few operations a tile of 4,096 triangles).
+fn by_tiles<T: PackTest>(
+    packs: &[T::Pack],
+    len: usize,
+    scans: &mut [Scan],
+    test_for: impl Fn(&Ray) -> T,
+) {
+    for (k, tile) in packs.chunks(TILE / 4).enumerate() {
+        for s in scans.iter_mut() {
+            blocks::<false, _>(&test_for(&s.ray), tile, k * TILE, len, s);
+        }
     }
 }
 
@@ -252,11 +252,11 @@ impl Accel for BruteForce {
                 tris.chunks(4)
                     .enumerate()
                     .map(|(k, four)| {
-                        let lanes = four
-                            .iter()
-                            .enumerate()
-                            .map(|(l, t)| ((4 * k + l) as u32, MollerTriangle::new(t)));
-                        Tri4::pack(&lanes.collect::<Vec<_>>())
+                        let mut pack = Tri4::default();
+                        for (l, t) in four.iter().enumerate() {
+                            pack.set_lane(l, (4 * k + l) as u32, &MollerTriangle::new(t));
+                        }
+                        pack
                     })
                     .collect(),
             ),

@@ -113,6 +113,17 @@ fn closest_point_on_zero_area_triangle_and_empty_mesh() {
     assert_eq!(bf.closest_point(Vec3::ZERO, f32::INFINITY), None);
 }
 
+/// `n` triangles of about unit size, their corners around points `spread` apart (`v` draws a
+/// point of the unit cube).
+fn soup(v: &mut impl FnMut() -> Vec3, n: usize, spread: f32) -> Vec<Triangle> {
+    (0..n)
+        .map(|_| {
+            let c = v() * spread;
+            Triangle::new(c + v() - Vec3::splat(0.5), c + v(), c - v())
+        })
+        .collect()
+}
+
 /// The scan in blocks (the branch-free candidate test first) answers and counts as a plain
 /// loop over every triangle with the deciding test, for both triangle tests: closest hit
 /// (ties to the lower index, layered and repeated triangles), any hit, and `prim_tests` up
@@ -122,12 +133,7 @@ fn the_blocked_scan_answers_and_counts_as_one_triangle_at_a_time() {
     let mut rng = raybench_geom::SplitMix64::new(0x2545_f491_4f6c_dd1d);
     let mut next = move || rng.unit();
     let mut v = || Vec3::new(next(), next(), next());
-    let mut tris: Vec<Triangle> = (0..1_000)
-        .map(|_| {
-            let c = v() * 4.0;
-            Triangle::new(c + v() - Vec3::splat(0.5), c + v(), c - v())
-        })
-        .collect();
+    let mut tris = soup(&mut v, 1_000, 4.0);
     // A repeated triangle in a later block: equal t, the earlier index must win.
     tris.push(tris[7]);
     tris.extend_from_within(40..45);
@@ -191,12 +197,7 @@ fn every_ray_at_once_answers_as_ray_by_ray() {
     let mut rng = raybench_geom::SplitMix64::new(0x9e37_79b9_7f4a_7c15);
     let mut next = move || rng.unit();
     let mut v = || Vec3::new(next(), next(), next());
-    let mut tris: Vec<Triangle> = (0..2 * TILE + 900)
-        .map(|_| {
-            let c = v() * 8.0;
-            Triangle::new(c + v() - Vec3::splat(0.5), c + v(), c - v())
-        })
-        .collect();
+    let mut tris = soup(&mut v, 2 * TILE + 900, 8.0);
     tris.extend_from_within(TILE - 20..TILE + 20);
     let mesh = Arc::new(TriangleMesh::from_triangles(&tris).unwrap().0);
     let rays: Vec<Ray> = (0..600)
