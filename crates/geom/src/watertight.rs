@@ -238,4 +238,46 @@ mod tests {
             "{hits} {rejected}"
         );
     }
+
+    /// Slivers whose third vertex lies within a few ulps to a thousandth of their opposite edge,
+    /// that edge crossing the ray: all three edge functions are about 0, one rounds or
+    /// underflows to exactly 0 in f32, the f32 signs and depth say miss, and only the redo in
+    /// f64 finds the hit. Here
+    /// `may_hit4` keeps its candidates by its exact-zero clause alone (the cases fail without
+    /// it), one triangle or four at a time.
+    #[test]
+    fn slivers_through_the_ray_stay_candidates() {
+        // Up to two ulps either way.
+        fn nudge(x: f32, r: &mut crate::SplitMix64) -> f32 {
+            let ulps = (r.unit() * 5.0) as i32 - 2;
+            f32::from_bits(x.to_bits().wrapping_add_signed(ulps))
+        }
+        let mut rng = crate::SplitMix64::new(6);
+        let mut tris = Vec::new();
+        for i in 0..30_000 {
+            let r = &mut rng;
+            let (ax, ay) = (r.unit() * 2.0 - 1.0, r.unit() * 2.0 - 1.0);
+            let k = 0.5 + r.unit() * 1.5;
+            let near = [1e-3, 1e-6, 0.0][i % 3] * r.unit();
+            let (bz, cz) = (1.0 + r.unit(), 1.0 + r.unit());
+            tris.push(Triangle::new(
+                Vec3::new(ax, ay, 1.0),
+                Vec3::new(nudge(-ax * k, r), nudge(-ay * k, r), bz),
+                Vec3::new(nudge(ax * near, r), nudge(ay * near, r), cz),
+            ));
+        }
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z, 0.0, f32::INFINITY);
+        let w = WatertightRay::new(&ray);
+        let mut hits = 0;
+        for four in tris.chunks_exact(4) {
+            let may = w.may_hit4(&Vertices4::pack(four));
+            for (l, tri) in four.iter().enumerate() {
+                let hit = w.intersect(tri);
+                assert!(may >> l & 1 != 0 || hit.is_none(), "{tri:?}");
+                assert_eq!(w.may_hit4(&Vertices4::pack(&[*tri])) & 1, may >> l & 1);
+                hits += hit.is_some() as usize;
+            }
+        }
+        assert!(hits > 1_000, "{hits}");
+    }
 }
