@@ -173,16 +173,9 @@ impl<const W: usize> BvhWide<W> {
     }
 }
 
-impl<const W: usize> Accel for BvhWide<W> {
-    type Params = WideParams;
-
-    fn build(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<BvhWide<W>, BuildError> {
-        if ![4, 8, 16].contains(&W) {
-            return Err(BuildError::Unsupported(format!(
-                "a {W}-wide BVH (4, 8 or 16 children: the SIMD node tests take 4, 8 or 16 lanes \
-                 at a time)"
-            )));
-        }
+/// [`Accel`]'s methods, for the widths that implement it (below).
+impl<const W: usize> BvhWide<W> {
+    fn build_wide(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<BvhWide<W>, BuildError> {
         if params.width as usize != W {
             return Err(BuildError::Unsupported(format!(
                 "width {} in a {W}-wide BVH",
@@ -240,7 +233,7 @@ impl<const W: usize> Accel for BvhWide<W> {
     /// The registered names. A 4-wide tree or a 16-wide binned tree with `coherent_packets` is
     /// registered nowhere; the packet walk runs on it all the same (the conformance tests check
     /// it), under its tree's name.
-    fn name(&self) -> &str {
+    fn registered_name(&self) -> &'static str {
         match (W, self.params.coherent_packets) {
             (8, false)
                 if self.params.binary.spatial_splits.is_some()
@@ -260,12 +253,10 @@ impl<const W: usize> Accel for BvhWide<W> {
         }
     }
 
-    raybench_accel::walk_queries!();
-
     /// With the packet walk, the rays are laid out in packets of sixteen, structure of arrays
     /// (as Embree's stream takes `RTCRayHit`s, converted outside timing); without it, as they
     /// are.
-    fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
+    fn prepare_coherent(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
         #[cfg(target_arch = "x86_64")]
         if self.coherent.is_some() {
             return Ok(raybench_accel::coherent::prepare_packets(rays));
@@ -273,7 +264,7 @@ impl<const W: usize> Accel for BvhWide<W> {
         Ok(PreparedRays::Native)
     }
 
-    fn intersect_prepared(
+    fn intersect_batch(
         &self,
         rays: &[Ray],
         prepared: &PreparedRays,
@@ -307,7 +298,7 @@ impl<const W: usize> Accel for BvhWide<W> {
         })
     }
 
-    fn occluded_prepared(
+    fn occluded_batch(
         &self,
         rays: &[Ray],
         prepared: &PreparedRays,
@@ -341,13 +332,13 @@ impl<const W: usize> Accel for BvhWide<W> {
         })
     }
 
-    fn build_stats(&self) -> BuildStats {
+    fn stats_with_splits(&self) -> BuildStats {
         let mut stats = self.measure();
         build::spatial_stats(&mut stats, self.spatial, self.mesh.len());
         stats
     }
 
-    fn memory(&self) -> Memory {
+    fn memory_held(&self) -> Memory {
         Memory {
             nodes: std::mem::size_of_val(self.nodes.as_slice()) as u64,
             // Triangle ids live in the `Tri4`s.
@@ -356,6 +347,62 @@ impl<const W: usize> Accel for BvhWide<W> {
         }
     }
 }
+
+/// [`Accel`] for each width the node tests are made for (4, 8 and 16; no other width has it),
+/// one impl per width rather than one generic impl: the walks and the build are then compiled
+/// in this crate, with its optimisation, not in whichever crate first names a width (the
+/// harness's test build is unoptimised, and its tests trace through these trees).
+macro_rules! accel_for_widths {
+    ($($w:literal)*) => {$(
+        impl Accel for BvhWide<$w> {
+            type Params = WideParams;
+
+            fn build(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<Self, BuildError> {
+                Self::build_wide(mesh, params)
+            }
+
+            fn name(&self) -> &str {
+                self.registered_name()
+            }
+
+            raybench_accel::walk_queries!();
+
+            fn prepare_coherent_rays(&self, rays: &[Ray]) -> Result<PreparedRays, RayError> {
+                self.prepare_coherent(rays)
+            }
+
+            fn intersect_prepared(
+                &self,
+                rays: &[Ray],
+                prepared: &PreparedRays,
+                first: usize,
+                out: &mut [Option<Hit>],
+            ) {
+                self.intersect_batch(rays, prepared, first, out)
+            }
+
+            fn occluded_prepared(
+                &self,
+                rays: &[Ray],
+                prepared: &PreparedRays,
+                first: usize,
+                out: &mut [bool],
+            ) {
+                self.occluded_batch(rays, prepared, first, out)
+            }
+
+            fn build_stats(&self) -> BuildStats {
+                self.stats_with_splits()
+            }
+
+            fn memory(&self) -> Memory {
+                self.memory_held()
+            }
+        }
+    )*};
+}
+
+accel_for_widths!(4 8 16);
 
 impl<const W: usize> Walk for BvhWide<W> {
     fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {

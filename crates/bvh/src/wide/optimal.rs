@@ -319,9 +319,9 @@ mod tests {
                 ..WideParams::for_width(W as u32)
             };
             let optimal =
-                BvhWide::<W>::build(mesh.clone(), &with(Collapse::Optimal)).expect("builds");
+                BvhWide::<W>::build_wide(mesh.clone(), &with(Collapse::Optimal)).expect("builds");
             let greedy =
-                BvhWide::<W>::build(mesh.clone(), &with(Collapse::Greedy)).expect("builds");
+                BvhWide::<W>::build_wide(mesh.clone(), &with(Collapse::Greedy)).expect("builds");
             optimal.validate(&mesh).expect("the tree validates");
             let p = &optimal.params().binary;
             let flat = build(&mesh, p).expect("builds");
@@ -335,7 +335,7 @@ mod tests {
                 built <= greedy * (1.0 + 1e-6),
                 "{spec}, {W} wide: {built} against greedy {greedy}"
             );
-            assert_eq!(optimal.build_stats().refs, mesh.len() as u64);
+            assert_eq!(optimal.stats_with_splits().refs, mesh.len() as u64);
         }
         for spec in [
             "teapot:triangles=20000",

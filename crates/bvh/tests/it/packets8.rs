@@ -42,7 +42,10 @@ fn runs_here<const W: usize>(bvh: &BvhWide<W>) -> bool {
 
 #[test]
 fn eight_lane_packets_conform_and_answer_as_single_rays_on_every_case() {
-    fn at<const W: usize>() {
+    fn at<const W: usize>()
+    where
+        BvhWide<W>: Accel<Params = WideParams>,
+    {
         let params = eight_lanes(W as u32);
         let counts = conformance::<BvhWide<W>>(&params, &|b, mesh| b.validate(mesh));
         assert_eq!(counts.mismatch, 0, "{W} wide");

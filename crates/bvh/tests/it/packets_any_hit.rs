@@ -22,7 +22,10 @@ fn packets(width: u32) -> WideParams {
 
 #[test]
 fn any_hit_packets_answer_as_single_rays_on_every_case() {
-    fn at<const W: usize>() {
+    fn at<const W: usize>()
+    where
+        BvhWide<W>: Accel<Params = WideParams>,
+    {
         for case in seeded_cases().into_iter().chain(edge_cases()) {
             let bvh = BvhWide::<W>::build(case.mesh.clone(), &packets(W as u32)).expect("builds");
             bvh.validate(&case.mesh)

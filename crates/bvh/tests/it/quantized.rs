@@ -44,7 +44,10 @@ fn param_sets<P: Plane>() -> [WideParams; 3] {
 
 #[test]
 fn compressed_conforms() {
-    fn check<P: Plane>() {
+    fn check<P: Plane>()
+    where
+        BvhQuantized<P>: Accel<Params = WideParams>,
+    {
         for params in param_sets::<P>() {
             check_conformance::<BvhQuantized<P>>(&params, &|b, mesh| b.validate(mesh));
         }
@@ -54,7 +57,10 @@ fn compressed_conforms() {
 
 #[test]
 fn compressed_conforms_on_the_shared_scenes() {
-    fn check<P: Plane>() {
+    fn check<P: Plane>()
+    where
+        BvhQuantized<P>: Accel<Params = WideParams>,
+    {
         let checked = raybench_testkit::conformance_on_shared_scenes::<BvhQuantized<P>>(
             &quantized::<P>(),
             &|b, m| b.validate(m),
@@ -69,7 +75,10 @@ fn compressed_conforms_on_the_shared_scenes() {
 /// boxes only grow) and visits the same leaves or more.
 #[test]
 fn answers_are_the_float_trees() {
-    fn check<P: Plane>() {
+    fn check<P: Plane>()
+    where
+        BvhQuantized<P>: Accel<Params = WideParams>,
+    {
         for (spec, seed) in [
             ("teapot:triangles=20000", 1),
             ("soup:triangles=5000", 7),
@@ -121,7 +130,10 @@ fn answers_are_the_float_trees() {
 /// `Tri4`s, every decoded box holding its float box.
 #[test]
 fn the_tree_is_the_float_tree_with_outward_rounded_boxes() {
-    fn check<P: Plane>() {
+    fn check<P: Plane>()
+    where
+        BvhQuantized<P>: Accel<Params = WideParams>,
+    {
         let mesh = generated("teapot:triangles=20000", 1);
         let float = Bvh8::build(mesh.clone(), &WideParams::for_width(8)).expect("builds");
         let q = BvhQuantized::<P>::build(mesh, &quantized::<P>()).expect("builds");
@@ -151,7 +163,10 @@ fn the_tree_is_the_float_tree_with_outward_rounded_boxes() {
 /// Empty and one-triangle meshes build, validate and answer (the root a leaf, no nodes).
 #[test]
 fn empty_and_single_triangle_meshes() {
-    fn check<P: Plane>() {
+    fn check<P: Plane>()
+    where
+        BvhQuantized<P>: Accel<Params = WideParams>,
+    {
         let empty = raybench_testkit::mesh(Vec::new(), Vec::new());
         let q = BvhQuantized::<P>::build(empty.clone(), &quantized::<P>()).expect("builds");
         q.validate(&empty).expect("valid");
@@ -184,7 +199,10 @@ fn empty_and_single_triangle_meshes() {
 /// packet walk (which reads float nodes).
 #[test]
 fn a_node_format_other_than_the_trees_is_refused() {
-    fn check<P: Plane>() {
+    fn check<P: Plane>()
+    where
+        BvhQuantized<P>: Accel<Params = WideParams>,
+    {
         let mesh = generated("soup:triangles=100", 1);
         for r in [
             Bvh8::build(mesh.clone(), &quantized::<P>()).map(|_| ()),
@@ -219,7 +237,10 @@ fn a_node_format_other_than_the_trees_is_refused() {
 /// The quantized tree does not depend on the thread count.
 #[test]
 fn the_same_tree_with_one_and_two_threads() {
-    fn check<P: Plane>() {
+    fn check<P: Plane>()
+    where
+        BvhQuantized<P>: Accel<Params = WideParams>,
+    {
         let mesh: Arc<_> = generated("teapot:triangles=20000", 1);
         let build = |threads| {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -246,7 +267,10 @@ fn the_same_tree_with_one_and_two_threads() {
 /// start on the roof and go up. Checked with the counters.
 #[test]
 fn rays_leaving_the_scene_through_its_top_end_at_the_root() {
-    fn check<P: Plane>() {
+    fn check<P: Plane>()
+    where
+        BvhQuantized<P>: Accel<Params = WideParams>,
+    {
         let (n, y) = (16, 0.7);
         let mut positions = Vec::new();
         for i in 0..=n {

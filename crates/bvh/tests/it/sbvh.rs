@@ -61,7 +61,10 @@ fn wide_sbvh_conforms() {
 /// the shared suite (whose coherent-batch check holds it to brute force), and on every case's
 /// rays the single-ray walk's answers but for ties. A triangle in two leaves a packet reaches is
 /// tested twice with the same answer, so duplicates change nothing a lane sees.
-fn packets_over_split_references_conform<const W: usize>(params: WideParams, name: &str) {
+fn packets_over_split_references_conform<const W: usize>(params: WideParams, name: &str)
+where
+    BvhWide<W>: Accel<Params = WideParams>,
+{
     let counts = conformance::<BvhWide<W>>(&params, &|b, m| b.validate(m));
     assert_eq!(counts.mismatch, 0, "{params:?}");
     assert!(counts.exact > 10_000, "{counts:?}");

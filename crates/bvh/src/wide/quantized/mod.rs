@@ -104,10 +104,12 @@ impl<P: Plane> BvhQuantized<P> {
     }
 }
 
-impl<P: Plane> Accel for BvhQuantized<P> {
-    type Params = WideParams;
-
-    fn build(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<BvhQuantized<P>, BuildError> {
+/// [`Accel`]'s methods, for the plane types that implement it (below).
+impl<P: Plane> BvhQuantized<P> {
+    fn build_quantized(
+        mesh: Arc<TriangleMesh>,
+        params: &WideParams,
+    ) -> Result<BvhQuantized<P>, BuildError> {
         if params.node_format != P::FORMAT {
             return Err(BuildError::Unsupported(format!(
                 "a {:?} BVH built with node_format = {:?}",
@@ -166,22 +168,14 @@ impl<P: Plane> Accel for BvhQuantized<P> {
         })
     }
 
-    fn name(&self) -> &str {
+    fn registered_name(&self) -> &'static str {
         match P::FORMAT {
             NodeFormat::Quantized16 => "bvh8-compressed16",
             _ => "bvh8-compressed",
         }
     }
 
-    raybench_accel::walk_queries!();
-
-    fn intersect_prepared(
-        &self,
-        rays: &[Ray],
-        _: &PreparedRays,
-        first: usize,
-        out: &mut [Option<Hit>],
-    ) {
+    fn intersect_batch(&self, rays: &[Ray], first: usize, out: &mut [Option<Hit>]) {
         let rays = &rays[first..];
         super::walk::with_stack(|stack| {
             #[cfg(target_arch = "x86_64")]
@@ -194,7 +188,7 @@ impl<P: Plane> Accel for BvhQuantized<P> {
         })
     }
 
-    fn occluded_prepared(&self, rays: &[Ray], _: &PreparedRays, first: usize, out: &mut [bool]) {
+    fn occluded_batch(&self, rays: &[Ray], first: usize, out: &mut [bool]) {
         let rays = &rays[first..];
         super::walk::with_stack(|stack| {
             #[cfg(target_arch = "x86_64")]
@@ -207,11 +201,7 @@ impl<P: Plane> Accel for BvhQuantized<P> {
         })
     }
 
-    fn build_stats(&self) -> BuildStats {
-        self.stats.clone()
-    }
-
-    fn memory(&self) -> Memory {
+    fn memory_held(&self) -> Memory {
         Memory {
             nodes: (std::mem::size_of_val(self.nodes.as_slice())
                 + std::mem::size_of::<WideNode<QWIDTH>>()) as u64,
@@ -220,6 +210,56 @@ impl<P: Plane> Accel for BvhQuantized<P> {
         }
     }
 }
+
+/// [`Accel`] for each plane type, one impl per type rather than one generic impl, so that the
+/// walks are compiled in this crate, with its optimisation (as for [`BvhWide`]).
+macro_rules! accel_for_planes {
+    ($($p:ty)*) => {$(
+        impl Accel for BvhQuantized<$p> {
+            type Params = WideParams;
+
+            fn build(mesh: Arc<TriangleMesh>, params: &WideParams) -> Result<Self, BuildError> {
+                Self::build_quantized(mesh, params)
+            }
+
+            fn name(&self) -> &str {
+                self.registered_name()
+            }
+
+            raybench_accel::walk_queries!();
+
+            fn intersect_prepared(
+                &self,
+                rays: &[Ray],
+                _: &PreparedRays,
+                first: usize,
+                out: &mut [Option<Hit>],
+            ) {
+                self.intersect_batch(rays, first, out)
+            }
+
+            fn occluded_prepared(
+                &self,
+                rays: &[Ray],
+                _: &PreparedRays,
+                first: usize,
+                out: &mut [bool],
+            ) {
+                self.occluded_batch(rays, first, out)
+            }
+
+            fn build_stats(&self) -> BuildStats {
+                self.stats.clone()
+            }
+
+            fn memory(&self) -> Memory {
+                self.memory_held()
+            }
+        }
+    )*};
+}
+
+accel_for_planes!(u8 u16);
 
 impl<P: Plane> Walk for BvhQuantized<P> {
     fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {

@@ -156,7 +156,6 @@ mod tests {
     use super::super::BvhQuantized;
     use super::super::node::Plane;
     use crate::wide::{NodeFormat, WideParams};
-    use raybench_accel::Accel;
 
     /// The validator catches a decoded box that no longer holds its triangles, and inverted
     /// bytes.
@@ -172,7 +171,7 @@ mod tests {
             node_format,
             ..WideParams::for_width(8)
         };
-        let mut q = BvhQuantized::<P>::build(mesh.clone(), &params).expect("builds");
+        let mut q = BvhQuantized::<P>::build_quantized(mesh.clone(), &params).expect("builds");
         q.validate(&mesh).expect("valid as built");
         let slot = (0..q.nodes[0].children())
             .find(|&i| q.nodes[0].q[0][1][i].get() > q.nodes[0].q[0][0][i].get())
