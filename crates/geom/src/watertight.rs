@@ -207,7 +207,7 @@ mod tests {
     /// is `Triangle::intersect_watertight`, on the Möller test's random and edge cases. None of
     /// them needs `may_hit4`'s clause for an edge function of exactly 0 (a redo in f64 that
     /// turns mixed signs into one sign is rare: none in 400,000 rays aimed at random triangles'
-    /// vertices); it stays, since the redo may change all three signs.
+    /// vertices); the slivers of the next test do.
     #[test]
     fn the_candidate_test_keeps_every_hit() {
         let cases = crate::triangle::tests::random_and_edge_cases();
@@ -242,9 +242,8 @@ mod tests {
     /// Slivers whose third vertex lies within a few ulps to a thousandth of their opposite edge,
     /// that edge crossing the ray: all three edge functions are about 0, one rounds or
     /// underflows to exactly 0 in f32, the f32 signs and depth say miss, and only the redo in
-    /// f64 finds the hit. Here
-    /// `may_hit4` keeps its candidates by its exact-zero clause alone (the cases fail without
-    /// it), one triangle or four at a time.
+    /// f64 finds the hit. Here `may_hit4` keeps its candidates by its exact-zero clause alone
+    /// (the test fails without it), one triangle or four at a time.
     #[test]
     fn slivers_through_the_ray_stay_candidates() {
         // Up to two ulps either way.

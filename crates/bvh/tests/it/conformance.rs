@@ -110,7 +110,7 @@ fn sixteen_wide_conforms() {
 /// the 4-, 8- and 16-wide trees implement `Accel`: other widths do not compile.
 #[test]
 fn a_width_other_than_the_trees_is_refused() {
-    use raybench_accel::{Accel, BuildError};
+    use raybench_accel::BuildError;
     let mesh = raybench_testkit::generated("soup:triangles=100", 1);
     for r in [
         Bvh4::build(mesh.clone(), &WideParams::for_width(8)).map(|_| ()),
@@ -126,7 +126,6 @@ fn a_width_other_than_the_trees_is_refused() {
 /// 8-wide tree is shallower and fuller.
 #[test]
 fn both_widths_share_the_leaves_and_differ_in_depth() {
-    use raybench_accel::Accel;
     let mesh = raybench_testkit::generated("teapot:triangles=20000", 1);
     let unfilled = |width| WideParams {
         fill_slots: false,
@@ -161,7 +160,6 @@ fn filling_slots_splits_leaves_and_lowers_the_sah() {
     where
         BvhWide<W>: Accel<Params = WideParams>,
     {
-        use raybench_accel::Accel;
         let mesh = raybench_testkit::generated(spec, 1);
         let with = |fill_slots| {
             let p = WideParams {
@@ -202,7 +200,6 @@ fn wide_trees_are_the_same_with_one_and_two_threads() {
     where
         BvhWide<W>: Accel<Params = WideParams>,
     {
-        use raybench_accel::Accel;
         let build = |threads| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -233,7 +230,7 @@ fn sse_matches_avx2_at<const W: usize>()
 where
     BvhWide<W>: Accel<Params = WideParams>,
 {
-    use raybench_accel::{Accel, Counters};
+    use raybench_accel::Counters;
     let sse = WideParams {
         node_simd: raybench_bvh::NodeSimd::Sse,
         ..WideParams::for_width(W as u32)
@@ -269,7 +266,6 @@ fn avx2_only_conforms_at<const W: usize>()
 where
     BvhWide<W>: Accel<Params = WideParams>,
 {
-    use raybench_accel::Accel;
     let auto = BvhWide::<W>::build(
         raybench_testkit::generated("sphere:triangles=200", 1),
         &WideParams::for_width(W as u32),
@@ -399,7 +395,7 @@ fn point_queries_conform_on_the_shared_scenes() {
 /// trees, with the estimate in the error.
 #[test]
 fn too_large_is_an_error_not_an_abort() {
-    use raybench_accel::{Accel, BuildError};
+    use raybench_accel::BuildError;
     let mesh = raybench_testkit::generated("soup:triangles=2000", 1);
     let small = BvhParams {
         memory_limit_bytes: 64 * 1024,
@@ -435,7 +431,6 @@ fn too_large_is_an_error_not_an_abort() {
 /// ray entered. Without AVX2 the batches are walked ray by ray and both checks still hold.
 #[test]
 fn packet_walk_conforms() {
-    use raybench_accel::Accel;
     fn at<const W: usize>()
     where
         BvhWide<W>: Accel<Params = WideParams>,
@@ -472,7 +467,7 @@ fn packet_walk_conforms() {
 /// without AVX2 (sixteen lanes with AVX-512F, eight with AVX2 alone).
 #[test]
 fn packet_walk_answers_camera_rays_as_the_single_ray_walk() {
-    use raybench_accel::{Accel, PreparedRays};
+    use raybench_accel::PreparedRays;
     let params = WideParams {
         coherent_packets: true,
         ..WideParams::for_width(8)
