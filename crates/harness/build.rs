@@ -10,9 +10,20 @@ fn output(cmd: &str, args: &[&str]) -> Option<String> {
 
 fn main() {
     let rev = output("git", &["rev-parse", "HEAD"]).unwrap_or_else(|| "unknown".into());
-    let dirty = output("git", &["status", "--porcelain", "--untracked-files=no"])
-        .map(|s| !s.is_empty())
-        .unwrap_or(false);
+    // `--no-optional-locks`: a plain `git status` rewrites .git/index to refresh its file
+    // times, and .git/index is one of the files below that rerun this script, so a build beside
+    // another (CI's test and release builds) would make the other's harness stale.
+    let dirty = output(
+        "git",
+        &[
+            "--no-optional-locks",
+            "status",
+            "--porcelain",
+            "--untracked-files=no",
+        ],
+    )
+    .map(|s| !s.is_empty())
+    .unwrap_or(false);
     let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
     let rustc_version = output(&rustc, &["-V"]).unwrap_or_else(|| "unknown".into());
     println!(
