@@ -17,6 +17,7 @@
 
 pub mod build;
 mod cover;
+mod grain;
 mod node;
 mod point;
 mod simd;
@@ -72,7 +73,9 @@ pub struct BvhParams {
     pub max_leaf_size: u32,
     /// Visit the nearer child first and skip subtrees beyond the closest hit.
     pub ordered: bool,
-    /// Ranges larger than this are built on two rayon tasks and binned in parallel.
+    /// Ranges larger than this are built on two rayon tasks. With several threads, a small
+    /// mesh's ranges are split from fewer triangles than this, down to 256, so that every
+    /// thread gets a share; the tree is the same either way.
     pub parallel_threshold: u32,
     /// The build refuses with [`BuildError::TooLarge`] when its estimate of the memory it
     /// needs (taken before allocating anything) exceeds this.

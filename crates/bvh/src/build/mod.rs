@@ -14,11 +14,12 @@
 //! one, while a larger range is cut in half in its current order — all centroids equal, say —
 //! so recursion always shrinks the range and always ends.
 //!
-//! Shape of the build: ranges above `parallel_threshold` are split on two rayon tasks
-//! (`Part::Split`); each range at or below it is built sequentially straight into its own
-//! depth-first node vector (`Part::Local`), all its nodes sharing one `split::Scratch`.
-//! Flattening then copies every node exactly once, relocating child indices — no node is boxed or
-//! allocated on its own.
+//! Shape of the build: ranges above a grain (`parallel_threshold`, finer on small meshes when
+//! there are several threads: see `grain.rs`) are split on two rayon tasks (`Part::Split`);
+//! each range at or below it is built sequentially straight into its own depth-first node
+//! vector (`Part::Local`), all its nodes sharing one `split::Scratch` (which the left side of
+//! each `Part::Split` takes over from its parent). Flattening then copies every node exactly
+//! once, relocating child indices — no node is boxed or allocated on its own.
 
 mod prim;
 pub mod reinsert;
@@ -111,7 +112,8 @@ pub(crate) fn build(mesh: &TriangleMesh, params: &BvhParams) -> Result<Flat, Bui
         .map(|i| PrimRef::new(&mesh.triangle(i).bounds(), i as u32))
         .collect();
     let whole = Ranged::of(&refs, PARALLEL_BINNING);
-    let part = build_part(params, &mut refs, 0, whole, 0);
+    let grain = task_grain(params, n);
+    let part = build_part(params, grain, &mut refs, 0, whole, 0, &mut Scratch::new());
     // At most n - 1 interior nodes in a binary tree with n or fewer leaves.
     let mut nodes = Vec::with_capacity(n - 1);
     let root = part.flatten(&mut nodes);
@@ -180,15 +182,35 @@ fn interior(index: usize) -> ChildRef {
     }
 }
 
-/// Builds `refs` (which start at triangle `first`) on rayon tasks while they are large.
-fn build_part(p: &BvhParams, refs: &mut [PrimRef], first: u32, r: Ranged, depth: usize) -> Part {
+/// Ranges of more triangles than this, in a build of `n`, are split on two rayon tasks: the
+/// `parallel_threshold` on large meshes or one thread, finer on small ones (see `grain.rs`).
+fn task_grain(p: &BvhParams, n: usize) -> usize {
+    crate::grain::grain(n, MIN_TASK, p.parallel_threshold as usize)
+}
+
+/// The fewest triangles a range built on its own task has (unless `parallel_threshold` is
+/// lower): below this the fork and the task's own node vector cost more than they balance.
+const MIN_TASK: usize = 256;
+
+/// Builds `refs` (which start at triangle `first`) on rayon tasks while they hold more than
+/// `grain` triangles. The left side of each split goes on with `scratch` and the right side,
+/// which another thread may take, makes its own.
+fn build_part(
+    p: &BvhParams,
+    grain: usize,
+    refs: &mut [PrimRef],
+    first: u32,
+    r: Ranged,
+    depth: usize,
+    scratch: &mut Scratch,
+) -> Part {
     let n = refs.len();
-    if n <= p.parallel_threshold as usize {
+    if n <= grain {
         let mut nodes = Vec::new();
-        let root = build_local(p, refs, first, r, depth, &mut nodes, &mut Scratch::new());
+        let root = build_local(p, refs, first, r, depth, &mut nodes, scratch);
         return Part::Local { nodes, root };
     }
-    let Some(s) = decide(p, refs, &r, depth, &mut Scratch::new()) else {
+    let Some(s) = decide(p, refs, &r, depth, scratch) else {
         let root = ChildRef {
             index: first,
             count: n as u32,
@@ -201,8 +223,11 @@ fn build_part(p: &BvhParams, refs: &mut [PrimRef], first: u32, r: Ranged, depth:
     let (left, right) = refs.split_at_mut(s.mid);
     let right_first = first + s.mid as u32;
     let children = rayon::join(
-        || build_part(p, left, first, s.left, depth + 1),
-        || build_part(p, right, right_first, s.right, depth + 1),
+        || build_part(p, grain, left, first, s.left, depth + 1, scratch),
+        || {
+            let scratch = &mut Scratch::new();
+            build_part(p, grain, right, right_first, s.right, depth + 1, scratch)
+        },
     );
     Part::Split {
         bounds: [s.left.bounds.to_aabb(), s.right.bounds.to_aabb()],

@@ -16,14 +16,20 @@ pub(super) struct Binary<'a, const W: usize> {
     sizes: Vec<u32>,
     fill_slots: bool,
     plan: Option<Plan<W>>,
+    /// Subtrees of at least this many triangles collapse their children on rayon.
+    grain: usize,
 }
 
 /// Leaves of more triangles than this (one `Tri4`) may be split to fill a node's empty slots.
 const SPLIT_LEAVES_ABOVE: u32 = 4;
 
-/// Subtrees of at least this many triangles collapse their children's subtrees on rayon
-/// (measured: see docs/experiments.md, "collapse on rayon").
+/// Subtrees of at least this many triangles collapse their children's subtrees on rayon in
+/// large trees (measured: see docs/experiments.md, "collapse on rayon"); small trees take a
+/// finer grain (see `grain.rs`), never under [`MIN_COLLAPSE_TASK`].
 const PARALLEL_COLLAPSE: usize = 4096;
+
+/// The fewest triangles a subtree collapsed on its own task has on small trees.
+const MIN_COLLAPSE_TASK: usize = 256;
 
 impl<const W: usize> Binary<'_, W> {
     /// `optimal`: the builder's prices to plan the children with (see `optimal.rs`), or
@@ -49,11 +55,13 @@ impl<const W: usize> Binary<'_, W> {
                 .sum();
         }
         let plan = optimal.map(|p| Plan::new(nodes, p));
+        let triangles = sizes.first().map_or(0, |&n| n as usize);
         Binary {
             nodes,
             sizes,
             fill_slots,
             plan,
+            grain: crate::grain::grain(triangles, MIN_COLLAPSE_TASK, PARALLEL_COLLAPSE),
         }
     }
 
@@ -182,11 +190,11 @@ fn split_leaf(refs: &mut [PrimRef], first: u32) -> [(ChildRef, Aabb); 2] {
 }
 
 /// Collapses the whole binary tree (root `r`, triangles `refs` from record 0) into wide
-/// nodes, depth-first; returns them with the reference to the root. Subtrees of
-/// [`PARALLEL_COLLAPSE`] triangles or more collapse their children on rayon into separate
-/// pieces ([`Piece`]); once every piece is done, each is copied exactly once into its place
-/// in the final array, in parallel too. The nodes and their order are the ones one thread
-/// makes.
+/// nodes, depth-first; returns them with the reference to the root. Subtrees of a grain of
+/// triangles or more ([`PARALLEL_COLLAPSE`] in large trees) collapse their children on rayon
+/// into separate pieces ([`Piece`]); once every piece is done, each is copied exactly once
+/// into its place in the final array, in parallel too. The nodes and their order are the
+/// ones one thread makes.
 pub(super) fn collapse_tree<const W: usize>(
     b: &Binary<W>,
     refs: &mut [PrimRef],
@@ -230,11 +238,11 @@ impl<const W: usize> Piece<W> {
 }
 
 /// Collapses the binary subtree `r`, whose triangles are `refs` (the first of them record
-/// `start`), into a [`Piece`]: on this thread below [`PARALLEL_COLLAPSE`] triangles, else with
-/// its children's subtrees on rayon.
+/// `start`), into a [`Piece`]: on this thread below the grain's triangles, else with its
+/// children's subtrees on rayon.
 fn piece<const W: usize>(b: &Binary<W>, refs: &mut [PrimRef], start: u32, r: ChildRef) -> Piece<W> {
     use rayon::prelude::*;
-    if r.is_leaf() || refs.len() < PARALLEL_COLLAPSE {
+    if r.is_leaf() || refs.len() < b.grain {
         let mut nodes = Vec::new();
         let root = collapse(b, refs, start, r, &mut nodes);
         return Piece::Local { nodes, root };

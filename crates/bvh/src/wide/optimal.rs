@@ -21,8 +21,9 @@
 //! fill any slot the chosen children leave empty.
 //!
 //! One pass over the binary nodes, children before parents, with at most `W²/2` sums each;
-//! subtrees of [`PARALLEL_PLAN`] nodes or more are planned on rayon, and the plan does not
-//! depend on the thread count.
+//! subtrees of a grain of nodes or more ([`PARALLEL_PLAN`] on large trees, finer on small
+//! ones: see `grain.rs`) are planned on rayon, and the plan does not depend on the thread
+//! count.
 
 use super::MAX_WIDTH;
 use crate::BvhParams;
@@ -34,6 +35,14 @@ use raybench_geom::Aabb;
 /// against 8,192, the bunny's and the 100k sphere's 2-thread builds 7 % faster (8,192 left the
 /// bunny's plan on one thread; see docs/experiments.md, "the plan forked from 1,024 nodes").
 const PARALLEL_PLAN: usize = 1024;
+
+/// The fewest binary nodes a subtree planned on its own task has on small trees.
+const MIN_PLAN_TASK: usize = 64;
+
+/// Subtrees of at least this many of a tree's `nodes` plan their children on rayon.
+fn plan_grain(nodes: usize) -> usize {
+    crate::grain::grain(nodes, MIN_PLAN_TASK, PARALLEL_PLAN)
+}
 
 /// One binary interior node's entry: for `i` = 1 to `W`, the least cost of covering it with
 /// at most `i` children (`cost[i - 1]`) and how (`cover[i - 1]`: `(0, 0)` the node alone, or
@@ -65,7 +74,7 @@ impl<const W: usize> Plan<W> {
     pub(super) fn new(nodes: &[Node], p: &BvhParams) -> Plan<W> {
         let mut entries = vec![Entry::EMPTY; nodes.len()];
         if !nodes.is_empty() {
-            plan(nodes, 0, &mut entries, p);
+            plan(nodes, 0, &mut entries, p, plan_grain(nodes.len()));
         }
         Plan { entries }
     }
@@ -124,7 +133,13 @@ impl<const W: usize> Plan<W> {
 
 /// Fills the entries of the subtree of binary interior node `at`: `entries` is exactly that
 /// subtree's range of the binary tree, so `entries[0]` is `at`'s entry.
-fn plan<const W: usize>(nodes: &[Node], at: usize, entries: &mut [Entry<W>], p: &BvhParams) {
+fn plan<const W: usize>(
+    nodes: &[Node],
+    at: usize,
+    entries: &mut [Entry<W>],
+    p: &BvhParams,
+    grain: usize,
+) {
     let node = &nodes[at];
     // A child's subtree starts at its index; the left one right after `at`.
     let (left, right) = (node.child[0], node.child[1]);
@@ -135,15 +150,15 @@ fn plan<const W: usize>(nodes: &[Node], at: usize, entries: &mut [Entry<W>], p: 
     };
     {
         let (left_part, right_part) = entries[1..].split_at_mut(right_offset - 1);
-        let big = left_part.len().min(right_part.len()) >= PARALLEL_PLAN;
+        let big = left_part.len().min(right_part.len()) >= grain;
         let go_left = |part: &mut [Entry<W>]| {
             if !left.is_leaf() {
-                plan(nodes, left.index as usize, part, p);
+                plan(nodes, left.index as usize, part, p, grain);
             }
         };
         let go_right = |part: &mut [Entry<W>]| {
             if !right.is_leaf() {
-                plan(nodes, right.index as usize, part, p);
+                plan(nodes, right.index as usize, part, p, grain);
             }
         };
         if big {
@@ -361,7 +376,7 @@ mod tests {
             flat.nodes.len() - right.index as usize,
         );
         assert!(
-            sides.0.min(sides.1) >= PARALLEL_PLAN,
+            sides.0.min(sides.1) >= plan_grain(flat.nodes.len()),
             "big enough to fork: {sides:?}"
         );
         let plan = |threads| {

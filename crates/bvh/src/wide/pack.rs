@@ -11,6 +11,10 @@ use raybench_geom::{MollerTriangle, Tri4, TriangleMesh};
 /// here).
 const AHEAD: usize = 2;
 
+/// The fewest `Tri4`s a fill task takes on small trees (large ones take 1,024 a task; see
+/// `grain.rs`).
+const MIN_FILL_TASK: usize = 64;
+
 /// One `Tri4`'s triangles: the builder's records `refs[start..start + len]`, `len` 1 to 4.
 #[derive(Clone, Copy)]
 pub(super) struct Tri4Source {
@@ -44,7 +48,7 @@ pub(super) fn fill_tri4s(
     let ahead = |k: usize, by: usize| sources.get(k + by).map_or(&[][..], |a| a.records(refs));
     (0..sources.len())
         .into_par_iter()
-        .with_min_len(1024)
+        .with_min_len(crate::grain::grain(sources.len(), MIN_FILL_TASK, 1024))
         .map(|k| {
             for p in ahead(k, 2 * AHEAD) {
                 prefetch(indices.as_ptr().wrapping_add(p.id() as usize));

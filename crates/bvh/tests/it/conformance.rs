@@ -193,7 +193,7 @@ fn filling_slots_splits_leaves_and_lowers_the_sah() {
 
 /// The wide trees do not depend on the thread count: the collapse runs its larger subtrees on
 /// rayon and places each child's nodes after its parent in slot order, as one thread makes
-/// them.
+/// them. A small mesh too, whose phases are cut into tasks of a few hundred triangles.
 #[test]
 fn wide_trees_are_the_same_with_one_and_two_threads() {
     fn check<const W: usize>(mesh: &std::sync::Arc<raybench_geom::TriangleMesh>)
@@ -209,17 +209,50 @@ fn wide_trees_are_the_same_with_one_and_two_threads() {
             pool.install(|| BvhWide::<W>::build(mesh.clone(), &params).expect("builds"))
         };
         let (one, two) = (build(1), build(2));
-        assert!(
-            one.nodes().len() > 100,
-            "big enough to collapse in parallel"
-        );
+        assert!(one.nodes().len() > 20, "big enough to collapse in parallel");
         assert!(one.nodes() == two.nodes(), "{W} wide: nodes differ");
         assert!(one.tri4s() == two.tri4s(), "{W} wide: Tri4s differ");
     }
-    let mesh = raybench_testkit::generated("teapot:triangles=20000", 1);
-    check::<8>(&mesh);
-    check::<4>(&mesh);
-    check::<16>(&mesh);
+    for spec in ["teapot:triangles=20000", "teapot:triangles=2000"] {
+        let mesh = raybench_testkit::generated(spec, 1);
+        check::<8>(&mesh);
+        check::<4>(&mesh);
+        check::<16>(&mesh);
+    }
+}
+
+/// The binary trees do not depend on how the build is cut into tasks: one thread with no
+/// parallel ranges at all, and two threads splitting every range of more than 16 triangles,
+/// make the same nodes and triangle order, for the binned builder, the wide trees' builder and
+/// the Split BVH's.
+#[test]
+fn binary_trees_do_not_depend_on_the_task_grain() {
+    let mesh = raybench_testkit::generated("teapot:triangles=3000", 2);
+    for base in [
+        BvhParams::binned(),
+        WideParams::default().binary,
+        WideParams::sbvh().binary,
+    ] {
+        let build = |threads, parallel_threshold| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a thread pool");
+            let params = BvhParams {
+                parallel_threshold,
+                ..base.clone()
+            };
+            pool.install(|| Bvh::build(mesh.clone(), &params).expect("builds"))
+        };
+        let (whole, split) = (build(1, u32::MAX), build(2, 16));
+        assert!(whole.nodes().len() > 100);
+        assert!(
+            whole.nodes() == split.nodes(),
+            "{:?}: nodes differ",
+            base.builder
+        );
+        assert_eq!(whole.prim_ids(), split.prim_ids());
+    }
 }
 
 /// The SSE kernels (what a CPU without AVX2 runs) answer like the AVX2 ones, at width `W`:

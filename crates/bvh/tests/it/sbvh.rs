@@ -177,7 +177,12 @@ fn no_budget_builds_the_binned_tree() {
 /// cuts are counted along its own line of cuts: city's ground reaches the default limit).
 #[test]
 fn sbvh_is_the_same_with_one_and_two_threads() {
-    for spec in ["hair", "soup:triangles=20000", "city:triangles=30000"] {
+    for spec in [
+        "hair",
+        "soup:triangles=20000",
+        "city:triangles=30000",
+        "soup:triangles=3000",
+    ] {
         let mesh = raybench_testkit::generated(spec, 5);
         let build = |threads| {
             let pool = rayon::ThreadPoolBuilder::new()

@@ -29,7 +29,7 @@ pub use bins::MAX_SPATIAL_BINS;
 
 use super::split::{PARALLEL_BINNING, Scratch, Split, binned_split, leaf_beats_any_split};
 use super::split::{split_cost, worth_splitting};
-use super::{Flat, Part, Ranged, build_local, build_part, interior};
+use super::{Flat, Part, Ranged, build_local, build_part, interior, task_grain};
 use crate::BvhParams;
 use crate::build::{Box3, PrimRef};
 use crate::node::{ChildRef, MAX_DEPTH, Node};
@@ -120,6 +120,8 @@ struct Ctx<'a> {
     mesh: &'a TriangleMesh,
     /// `alpha` × the root's half area.
     min_overlap: f64,
+    /// Nodes of more references than this split their children on two rayon tasks.
+    grain: usize,
     /// The binary builder's knobs with the spatial splits' `intersection_cost`.
     priced: BvhParams,
     /// Spatial splits searched for so far, on every task: a count of a set of nodes that does
@@ -185,6 +187,7 @@ pub(crate) fn build(mesh: &TriangleMesh, p: &BvhParams, s: &SpatialSplits) -> Fl
         s,
         mesh,
         min_overlap: s.alpha as f64 * whole.bounds.half_area(),
+        grain: task_grain(p, n),
         priced: BvhParams {
             intersection_cost: s.intersection_cost,
             ..p.clone()
@@ -371,7 +374,7 @@ impl Ctx<'_> {
         let left_slot = Slot::new(left_refs, slot.at, nl);
         let right_slot = Slot::new(right_refs, slot.at + placed.right_at, nr);
         let [left_budget, right_budget] = placed.budgets;
-        let children = if nl + nr > self.p.parallel_threshold as usize {
+        let children = if nl + nr > self.grain {
             rayon::join(
                 || self.node(left_slot, left, depth + 1, left_budget, w),
                 || self.node(right_slot, right, depth + 1, right_budget, &mut Work::new()),
@@ -392,8 +395,8 @@ impl Ctx<'_> {
     fn binned(&self, mut slot: Slot, r: Ranged, depth: usize, w: &mut Work) -> Tree {
         let (at, count) = (slot.at, slot.count);
         let refs = slot.live();
-        let part = if count > self.p.parallel_threshold as usize {
-            build_part(self.p, refs, 0, r, depth)
+        let part = if count > self.grain {
+            build_part(self.p, self.grain, refs, 0, r, depth, &mut w.binned)
         } else {
             let mut nodes = Vec::new();
             let root = build_local(self.p, refs, 0, r, depth, &mut nodes, &mut w.binned);
