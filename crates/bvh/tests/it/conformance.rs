@@ -1,5 +1,6 @@
 //! The shared conformance suite for every BVH variant, `validate()` after every build.
 
+use crate::on_threads;
 use raybench_accel::Accel;
 use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh16, BvhParams, BvhWide, Collapse, WideParams};
 use raybench_testkit::conformance;
@@ -200,13 +201,11 @@ fn wide_trees_are_the_same_with_one_and_two_threads() {
     where
         BvhWide<W>: Accel<Params = WideParams>,
     {
+        let params = WideParams::for_width(W as u32);
         let build = |threads| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("a thread pool");
-            let params = WideParams::for_width(W as u32);
-            pool.install(|| BvhWide::<W>::build(mesh.clone(), &params).expect("builds"))
+            on_threads(threads, || {
+                BvhWide::<W>::build(mesh.clone(), &params).expect("builds")
+            })
         };
         let (one, two) = (build(1), build(2));
         assert!(one.nodes().len() > 20, "big enough to collapse in parallel");
@@ -234,15 +233,13 @@ fn binary_trees_do_not_depend_on_the_task_grain() {
         WideParams::sbvh().binary,
     ] {
         let build = |threads, parallel_threshold| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("a thread pool");
             let params = BvhParams {
                 parallel_threshold,
                 ..base.clone()
             };
-            pool.install(|| Bvh::build(mesh.clone(), &params).expect("builds"))
+            on_threads(threads, || {
+                Bvh::build(mesh.clone(), &params).expect("builds")
+            })
         };
         let (whole, split) = (build(1, u32::MAX), build(2, 16));
         assert!(whole.nodes().len() > 100);

@@ -2,6 +2,7 @@
 //! 16-bit): the shared suite with `validate()` after every build, and what they must share
 //! with the float tree they are converted from.
 
+use crate::on_threads;
 use raybench_accel::{Accel, BuildError, Counters};
 use raybench_bvh::wide::Plane;
 use raybench_bvh::{Bvh8, BvhParams, BvhQuantized, NodeFormat, NodeSimd, WideParams};
@@ -243,11 +244,7 @@ fn the_same_tree_with_one_and_two_threads() {
     {
         let mesh: Arc<_> = generated("teapot:triangles=20000", 1);
         let build = |threads| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("a thread pool");
-            pool.install(|| {
+            on_threads(threads, || {
                 BvhQuantized::<P>::build(mesh.clone(), &quantized::<P>()).expect("builds")
             })
         };

@@ -1,6 +1,7 @@
 //! The reinsertion optimizer (`BvhParams::reinsertion`) on built trees: the shared suite, the
 //! SAH cost it reports, and the same tree on any thread count.
 
+use crate::on_threads;
 use raybench_accel::{Accel, BuildStats};
 use raybench_bvh::{Bvh, Bvh8, BvhParams, Reinsertion, WideParams};
 use raybench_testkit::conformance;
@@ -206,27 +207,17 @@ fn edge_cases_build_and_validate() {
 #[test]
 fn the_same_tree_with_one_and_two_threads() {
     let mesh = raybench_testkit::generated("teapot-in-stadium", 1);
-    let pool = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool")
-    };
     let wide_params = wide();
-    let (one, two) = (
-        pool(1).install(|| Bvh8::build(mesh.clone(), &wide_params).expect("builds")),
-        pool(2).install(|| Bvh8::build(mesh.clone(), &wide_params).expect("builds")),
-    );
+    let build = |threads| on_threads(threads, || Bvh8::build(mesh.clone(), &wide_params));
+    let (one, two) = (build(1).expect("builds"), build(2).expect("builds"));
     let moves = figure(&one.build_stats(), "reinsert_moves");
     assert!(moves > 10.0, "{moves} moves: the test proves little");
     assert!(one.nodes() == two.nodes(), "nodes differ");
     assert!(one.tri4s() == two.tri4s(), "Tri4s differ");
     assert_eq!(one.build_stats(), two.build_stats());
     let p = with_reinsertion(BvhParams::median());
-    let (one, two) = (
-        pool(1).install(|| Bvh::build(mesh.clone(), &p).expect("builds")),
-        pool(2).install(|| Bvh::build(mesh.clone(), &p).expect("builds")),
-    );
+    let build = |threads| on_threads(threads, || Bvh::build(mesh.clone(), &p));
+    let (one, two) = (build(1).expect("builds"), build(2).expect("builds"));
     assert!(one.nodes() == two.nodes(), "binary nodes differ");
     assert_eq!(one.prim_ids(), two.prim_ids());
 }

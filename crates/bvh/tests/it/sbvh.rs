@@ -1,6 +1,7 @@
 //! Spatial splits (`bvh8-sbvh`, and the binary tree with the same knob): the shared suite, a
 //! scene where spatial splits must pay off, the reference budget, and thread independence.
 
+use crate::on_threads;
 use raybench_accel::{Accel, BuildStats, Counters};
 use raybench_bvh::{Bvh, Bvh8, BvhParams, BvhWide, PacketFloors, SpatialSplits, WideParams};
 use raybench_testkit::{Case, check_case, conformance};
@@ -185,11 +186,9 @@ fn sbvh_is_the_same_with_one_and_two_threads() {
     ] {
         let mesh = raybench_testkit::generated(spec, 5);
         let build = |threads| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("a thread pool");
-            pool.install(|| Bvh8::build(mesh.clone(), &WideParams::sbvh()).expect("builds"))
+            on_threads(threads, || {
+                Bvh8::build(mesh.clone(), &WideParams::sbvh()).expect("builds")
+            })
         };
         let (one, two) = (build(1), build(2));
         assert!(
