@@ -1,7 +1,7 @@
 //! The two-level grid: the shared conformance suite with `validate()` after every build, knobs
 //! at their extremes, the teapot in a stadium at size ratios where the uniform grid collapses,
-//! rays along cell planes at both levels, the same structure on any thread count, and memory
-//! errors instead of aborts.
+//! rays along cell planes at both levels, the same structure on any thread count, copies of
+//! one triangle kept in lists, and memory errors instead of aborts.
 
 use raybench_accel::{Accel, Counters};
 use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
@@ -186,6 +186,33 @@ fn too_large_is_an_error_not_an_abort() {
         ..Grid2Params::default()
     };
     assert!(Grid2::build(Arc::clone(&mesh), &bad).is_err());
+}
+
+/// Copies of one triangle cannot be told apart by any grid: every cell one crosses holds them
+/// all. Their crowded cells keep their lists, so the build makes the top grid's references and
+/// no more, where each level would copy the whole list into every cell it crosses, and the
+/// answers stay right. Distinct triangles crowding a cell still get cell grids.
+#[test]
+fn copies_of_one_triangle_get_no_cell_grids() {
+    let mesh = generated("identical:triangles=300", SEED);
+    // The knobs that subdivide the most.
+    let params = Grid2Params::deep();
+    let g = Grid2::build(mesh.clone(), &params).unwrap();
+    assert_eq!(g.validate(&mesh), Ok(()));
+    assert_eq!(g.cell_grids(), 0);
+    let top = Grid::build(mesh.clone(), &GridParams::with_density(params.top_density)).unwrap();
+    assert_eq!(g.build_stats().refs, top.build_stats().refs);
+    let case = Case {
+        name: "identical".into(),
+        seed: SEED,
+        mesh: mesh.clone(),
+        rays: random_rays_in(&mesh.bounds().enlarged(0.5), 500, SEED),
+    };
+    let counts = check_case::<Grid2>(&case, &params, &|g, m| g.validate(m)).unwrap();
+    assert_eq!(counts.mismatch, 0);
+    assert!(counts.tie > 0, "some rays hit the copies: {counts:?}");
+    let soup = generated("soup:triangles=3000", SEED);
+    assert!(Grid2::build(soup, &params).unwrap().cell_grids() > 0);
 }
 
 #[test]

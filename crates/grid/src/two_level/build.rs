@@ -122,8 +122,9 @@ impl Inserted {
 /// The grid a cell of a grid at `level` (the top grid is level 0) gets for its triangles
 /// `list`, inserted, or `None` when it keeps its list: the cell must be crowded
 /// ([`may_subdivide`]), its grid more than one cell ([`cell_layout`]; `cell` is the cell's
-/// enlarged box, `m` the insertion margin) and [`worth_it`] (first with one reference per
-/// triangle, before paying for the insertion). Build and `validate()` both decide with it.
+/// enlarged box, `m` the insertion margin), [`worth_it`] (first with one reference per
+/// triangle, before paying for the insertion) and able to tell the list's triangles apart
+/// ([`separates`]). Build and `validate()` both decide with it.
 pub(super) fn own_grid(
     mesh: &TriangleMesh,
     list: &[u32],
@@ -136,7 +137,7 @@ pub(super) fn own_grid(
         return None;
     }
     let layout = cell_layout(mesh, list, cell, m, params)?;
-    if !worth_it(list.len(), list.len(), &layout, params) {
+    if !worth_it(list.len(), list.len(), &layout, params) || !separates(mesh, list, &layout) {
         return None;
     }
     // Checked after every triangle, so a grid that comes back passed with all its references.
@@ -147,6 +148,30 @@ pub(super) fn own_grid(
         offsets,
         refs,
     })
+}
+
+/// Triangles of a list that [`separates`] inserts: the first, the middle and the last.
+const SAMPLES: usize = 3;
+
+/// Whether `layout` puts the triangles of `list` into different cells, judged on [`SAMPLES`]
+/// of them spread over the list. When every sampled triangle lands in exactly the same cells
+/// (copies of one triangle, say), the grid would copy the whole list into each of those cells,
+/// whose own grids would do the same again down to the last level, each insertion testing every
+/// triangle against every cell its box covers: for `k` copies of a triangle across the cell,
+/// about `k` times the grid's `cell_density · k` cells a level, so a thousand copies cost
+/// billions of triangle-cell tests. [`worth_it`] cannot see this: it prices the mean cell, and
+/// the copies crowd a few cells of an otherwise empty grid. The check inserts three triangles
+/// where the insertion would insert them all; a list it refuses stays a list, which costs only
+/// speed where the sample misjudges.
+fn separates(mesh: &TriangleMesh, list: &[u32], layout: &Layout) -> bool {
+    let cells_of = |id: u32| {
+        let mut cells = Vec::new();
+        layout.for_each_cell_clipped(&mesh.triangle(id as usize), |c| cells.push(c));
+        cells
+    };
+    let last = list.len() - 1;
+    let first = cells_of(list[0]);
+    (1..SAMPLES).any(|s| cells_of(list[s * last / (SAMPLES - 1)]) != first)
 }
 
 /// A cell grid being built: its cells' lists (also those of cells with a grid of their own,
