@@ -11,10 +11,11 @@
 //!   part of the cell its triangles occupy (their bounds clipped to the cell, both enlarged by
 //!   the insertion margin), not over the whole cell: a teapot in one stadium cell gets its grid
 //!   around the teapot, so the detail is resolved however small it is against the stadium.
-//!   A cell whose own grid would have one cell keeps its list. Within a cell grid, a cell
-//!   still holding more than `crowded` triangles gets a grid of its own the same way, down to
-//!   `max_levels` levels: a teapot at 1e-5 of its stadium is several orders of magnitude below
-//!   one level's resolution, and each level resolves about two.
+//!   A cell whose own grid would have one cell, would not pay by the cost model, or would put
+//!   its triangles all in the same cells (copies of one triangle) keeps its list. Within a
+//!   cell grid, a cell still holding more than `crowded` triangles gets a grid of its own the
+//!   same way, down to `max_levels` levels: a teapot at 1e-5 of its stadium is several orders
+//!   of magnitude below one level's resolution, and each level resolves about two.
 //! * A ray walks the top grid with the 3D-DDA; in a cell with a grid of its own it clips itself
 //!   to that grid's box and walks it with the same DDA (and so on down), one mailbox and one
 //!   closest hit for the whole ray. Every walk stops at the first cell whose exit lies beyond
