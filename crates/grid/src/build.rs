@@ -13,7 +13,10 @@
 //! the f32 DDA can never disagree with insertion about which side of a plane it is on by more).
 //! A triangle whose bounding box meets a single cell skips the test. The trade-off: the test
 //! costs ~100 flops per candidate cell at build time, and saves every useless reference of a
-//! long or slanted triangle at trace time.
+//! long or slanted triangle at trace time. A triangle whose bounding box holds many cells (a
+//! hair strand, a ground plane) is first clipped to each layer and row of cells, so only the
+//! cells it can reach are tested ([`crate::reach`]): the same references, without a test per
+//! cell of the box.
 //!
 //! Storage is one offsets array (cells + 1 entries) into one reference array, never a `Vec`
 //! per cell: insertion (parallel over chunks of triangles) emits `(cell, triangle)` pairs in
@@ -58,13 +61,13 @@ pub struct Layout {
 }
 
 /// The largest f32 not above `x` (for finite `x` in f32 range).
-fn f32_down(x: f64) -> f32 {
+pub(crate) fn f32_down(x: f64) -> f32 {
     let f = x as f32;
     if f as f64 > x { f.next_down() } else { f }
 }
 
 /// The smallest f32 not below `x`.
-fn f32_up(x: f64) -> f32 {
+pub(crate) fn f32_up(x: f64) -> f32 {
     let f = x as f32;
     if (f as f64) < x { f.next_up() } else { f }
 }
@@ -148,6 +151,18 @@ impl Layout {
         self.planes[a].iter().map(|&p| p as f32).collect()
     }
 
+    /// Whether the triangle overlaps cell `c`'s enlarged box, by the 3 edge axes along `flat`
+    /// when it lies within the cell's slab on that axis, else by all 10 non-box axes (its
+    /// bounding box meets the cell's: the cell is one of its candidates).
+    #[inline(always)]
+    pub(crate) fn overlaps(&self, tb: &TriBox, flat: Option<usize>, c: [u32; 3]) -> bool {
+        let (clo, chi) = self.cell_box(c);
+        match flat {
+            Some(axis) => tb.edges_overlap_along(clo, chi, axis),
+            None => tb.plane_and_edges_overlap(clo, chi),
+        }
+    }
+
     /// Cell `(x, y, z)` enlarged by the margin: the box the overlap test sees.
     #[inline]
     pub fn cell_box(&self, c: [u32; 3]) -> (DVec3, DVec3) {
@@ -197,7 +212,7 @@ impl Layout {
     /// coordinate overlaps nothing.
     #[inline]
     pub fn for_each_cell(&self, tri: &Triangle, emit: impl FnMut(usize)) {
-        self.insert::<false>(tri, emit)
+        self.insert::<false>(tri, crate::reach::REACH_FROM, emit)
     }
 
     /// [`Layout::for_each_cell`] for a triangle that may reach beyond the layout's box (a
@@ -208,11 +223,18 @@ impl Layout {
     /// inserted into the parent cell), within its bounding box, so within that cell.
     #[inline]
     pub fn for_each_cell_clipped(&self, tri: &Triangle, emit: impl FnMut(usize)) {
-        self.insert::<true>(tri, emit)
+        self.insert::<true>(tri, crate::reach::REACH_FROM, emit)
     }
 
+    /// Both of the above; from `reach_from` candidate cells the candidates are narrowed by
+    /// clipping (the tests compare it with `u64::MAX`, the full scan).
     #[inline]
-    fn insert<const CLIPPED: bool>(&self, tri: &Triangle, mut emit: impl FnMut(usize)) {
+    pub(crate) fn insert<const CLIPPED: bool>(
+        &self,
+        tri: &Triangle,
+        reach_from: u64,
+        mut emit: impl FnMut(usize),
+    ) {
         let b = tri.bounds();
         if !b.min.cmple(b.max).all() {
             return;
@@ -240,15 +262,14 @@ impl Layout {
         } else {
             (0..3).find(|&a| r[a].0 == r[a].1)
         };
+        let candidates: u64 = r.iter().map(|&(f, l)| (l - f + 1) as u64).product();
+        if candidates >= reach_from {
+            return self.insert_reached(&tb, r, flat, emit);
+        }
         for z in r[2].0..=r[2].1 {
             for y in r[1].0..=r[1].1 {
                 for x in r[0].0..=r[0].1 {
-                    let (clo, chi) = self.cell_box([x, y, z]);
-                    let overlaps = match flat {
-                        Some(axis) => tb.edges_overlap_along(clo, chi, axis),
-                        None => tb.plane_and_edges_overlap(clo, chi),
-                    };
-                    if overlaps {
+                    if self.overlaps(&tb, flat, [x, y, z]) {
                         emit(self.index([x, y, z]));
                     }
                 }

@@ -29,6 +29,7 @@
 pub mod build;
 mod dda;
 mod points;
+mod reach;
 pub mod skip;
 mod traverse;
 pub mod two_level;
