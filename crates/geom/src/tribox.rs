@@ -124,8 +124,8 @@ impl TriBox {
     /// The 3 axes `edge × unit(axis)` alone: the projections of the triangle and the box along
     /// `axis` overlap, as 2D shapes. For a triangle known to lie within the box's slab on
     /// `axis` (and whose bounding box meets the box), that is the whole overlap test. Always
-    /// inlined: grid insertion calls it once a candidate cell from two loops, and a call costs
-    /// about as much as the test of a flat triangle.
+    /// inlined: grid insertion calls it for every candidate cell, from two loops (the full scan
+    /// and the clipped one), and a call costs about as much as the test of a flat triangle.
     #[inline(always)]
     pub fn edges_overlap_along(&self, lo: DVec3, hi: DVec3, axis: usize) -> bool {
         let c = lo * 0.5 + hi * 0.5;
