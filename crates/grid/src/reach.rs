@@ -5,8 +5,10 @@
 //! box costs a test per box cell for a reference per sheet cell: for triangles that span the
 //! grid that is quadratic in the resolution, and with many such triangles the build spends
 //! minutes on tests that fail. Clipping the triangle to the slab of one layer of cells along
-//! z, and that piece to the slab of one row along y, gives the x extent the triangle has in the
-//! row, so the candidates number about the references plus a few per row.
+//! z gives the part of it in that layer; that part's vertices within the slab of one row along
+//! y and its edges' crossings with the row's planes give the x extent the triangle has in the
+//! row (without building the row's part), so the candidates number about the references plus
+//! a few per row.
 //!
 //! The clip only narrows the candidates; the triangle–box test still decides every one, so the
 //! references are exactly those of the full scan (the unit tests compare the two). To leave out
@@ -195,9 +197,7 @@ fn grow(e: Option<(f64, f64)>, x: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::build::Layout;
     use raybench_geom::rng::SplitMix64;
-    use raybench_geom::tribox::TriBox;
     use raybench_geom::{Triangle, Vec3};
 
     /// The cells of `tri` with the clipping from `reach_from` candidates, in emitted order.
