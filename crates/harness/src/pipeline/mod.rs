@@ -17,5 +17,3 @@ pub mod verify;
 pub mod watertight;
 pub mod workers;
 pub mod workloads;
-
-pub use rounds::ONE_COPY_FROM;

@@ -7,8 +7,7 @@
 //! of the per-round ratios, with a confidence interval ([`crate::report::interval`]).
 //!
 //! The price is memory: all of a scene's structures (and their prepared rays) are alive
-//! together, where measuring one after the other held one at a time. Each is held as one copy
-//! when it is large ([`ONE_COPY_FROM`]).
+//! together, where measuring one after the other held one at a time.
 
 use super::measure::{Answers, LONG_PASS, point_pass, trace_pass};
 use super::run::RunOptions;
@@ -17,17 +16,15 @@ use super::workloads::SceneRun;
 use crate::registry::{BuildContext, Built, StructureEntry};
 use crate::report::interval::{median_with_interval, paired_ratios};
 use crate::report::run::{ResultEntry, Throughput, Timing};
-use anyhow::{Result, bail};
-use raybench_accel::{Accel, PointHit, PreparedRays};
+use anyhow::Result;
+use raybench_accel::{PointHit, PreparedRays};
 use std::time::{Duration, Instant};
 
 /// One structure of a scene, built and checked, waiting for its timed passes.
 pub(super) struct Pending<'e> {
     pub entry: &'e StructureEntry,
-    /// The structure every pass traces: the warm-up build, or for a structure over
-    /// [`ONE_COPY_FROM`] each timed build in its place. `None` only while such a build runs, or
-    /// after one failed (which ends the structure's rounds).
-    built: Option<Built>,
+    /// The warm-up build: the one every pass traces.
+    pub built: Built,
     /// Everything but the timings, which [`finish`](Pending::finish) fills in.
     pub result: ResultEntry,
     pub jobs: Vec<Job>,
@@ -114,49 +111,29 @@ impl<'e> Pending<'e> {
     pub(super) fn new(entry: &'e StructureEntry, built: Built, result: ResultEntry) -> Self {
         Pending {
             entry,
-            built: Some(built),
+            built,
             result,
             jobs: Vec::new(),
             build_ms: Vec::new(),
         }
     }
 
-    /// The warm-up build, before the rounds begin (`None` once a timed build failed).
-    pub(super) fn warm_up(&self) -> Option<&dyn Accel> {
-        self.built.as_ref().map(|b| b.accel.as_ref())
-    }
-
-    /// Round `r`: one timed build while `r < build_runs`, and one timed pass of each workload
-    /// that still has runs left. The new structure is dropped outside the timed window, and
-    /// the passes trace the warm-up build, unless the structure is over [`ONE_COPY_FROM`]: then
-    /// the structure traced so far is dropped before the timed build, which takes its place. An
-    /// `extra` round (past the fixed ones, see [`time_in_rounds`]) builds nothing and traces
-    /// every workload that is not timed once.
+    /// Round `r`: one timed build (the new structure is dropped outside the timed window) while
+    /// `r < build_runs`, and one timed pass of each workload that still has runs left.
+    /// An `extra` round (past the fixed ones, see [`time_in_rounds`]) builds nothing and
+    /// traces every workload that is not timed once.
     fn round(&mut self, r: usize, extra: bool, sr: &SceneRun, opts: &RunOptions) -> Result<()> {
+        let mesh = &sr.scene.scene.mesh;
         if !extra && r < opts.build_runs.max(1) {
             let ctx = BuildContext {
                 threads: opts.threads,
             };
-            let one_copy = self.result.memory_bytes > ONE_COPY_FROM;
-            if one_copy {
-                drop(self.built.take());
-            }
             let start = Instant::now();
-            let next = self.entry.build(sr.scene.scene.mesh.clone(), &ctx)?;
+            let next = self.entry.build(mesh.clone(), &ctx)?;
             self.build_ms.push(start.elapsed().as_secs_f64() * 1e3);
-            if one_copy {
-                self.built = Some(next);
-            } else {
-                drop(next);
-            }
+            drop(next);
         }
-        // The checks ran on the warm-up build. A timed build that replaced it stands for it:
-        // each of our builders gives the same structure on every build and thread count (the
-        // tests assert it), and Embree's is the same scene built with the same settings.
-        let Some(built) = &self.built else {
-            bail!("no structure to trace: its timed build failed");
-        };
-        let accel = built.accel.as_ref();
+        let accel = self.built.accel.as_ref();
         let runs_now = |j: &Job| if extra { j.runs > 1 } else { r < j.runs };
         for job in self.jobs.iter_mut().filter(|j| runs_now(j)) {
             let (queries, took) = match &mut job.kind {
@@ -191,15 +168,6 @@ impl<'e> Pending<'e> {
         self.result
     }
 }
-
-/// Structures larger than this (their memory as reported) are held as one copy during the
-/// rounds: each timed build replaces the structure traced so far, instead of living beside it
-/// until its clock stops. A scene then never holds two copies of a structure that may be near
-/// its builder's `memory_limit_bytes` (a run could otherwise need twice the limit for one
-/// structure, and be killed). Smaller ones keep the warm-up build: every pass then traces the
-/// checked structure, in a cache state its own last build does not set. A structure this large
-/// is far beyond any cache, so which copy is traced does not change its timing.
-pub const ONE_COPY_FROM: u64 = 1 << 30;
 
 /// How many rounds a run's settings take: enough for every timed build and pass.
 pub(super) fn rounds(opts: &RunOptions) -> usize {
