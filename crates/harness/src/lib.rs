@@ -11,6 +11,7 @@ pub mod atomic;
 pub mod cli;
 pub mod env;
 pub mod interrupt;
+pub mod memory;
 pub mod outdir;
 pub mod output;
 #[cfg(feature = "peers")]

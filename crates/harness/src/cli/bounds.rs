@@ -26,18 +26,6 @@ pub const MAX_RUNS: usize = 1000;
 /// Most worker threads per core: oversubscription can be measured, a thread storm cannot.
 pub const THREADS_PER_CORE: usize = 8;
 
-/// Physical memory in bytes (`/proc/meminfo`), or 8 GiB when it cannot be read.
-pub fn physical_memory() -> u64 {
-    std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|text| {
-            let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
-            let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-            Some(kib * 1024)
-        })
-        .unwrap_or(8 << 30)
-}
-
 fn gib(bytes: f64) -> String {
     let g = bytes / (1u64 << 30) as f64;
     if g < 1e6 {
@@ -77,7 +65,7 @@ pub fn check_points(n: usize, point_workloads: usize) -> Result<()> {
 }
 
 fn check_count(flag: &str, unit: &str, n: usize, per_item: u64, what: &str) -> Result<()> {
-    let memory = physical_memory();
+    let memory = crate::memory::physical();
     let allowed = (memory as f64 * MEMORY_SHARE / per_item as f64) as u64;
     if n as u64 > allowed {
         bail!(

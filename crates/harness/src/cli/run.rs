@@ -279,7 +279,7 @@ fn picture_width(text: &str) -> Result<u32, String> {
 /// memory, before any work.
 fn check_picture_memory(width: u32, structures: usize) -> Result<()> {
     let need = picture::picture_bytes(width, structures);
-    let have = super::bounds::physical_memory();
+    let have = crate::memory::physical();
     anyhow::ensure!(
         need <= have / 2,
         "--picture-width {width} needs about {:.1} GiB per scene with {structures} structures, \

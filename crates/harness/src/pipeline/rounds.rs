@@ -29,6 +29,11 @@ pub(super) struct Pending<'e> {
     pub result: ResultEntry,
     pub jobs: Vec<Job>,
     build_ms: Vec<f64>,
+    /// How long the warm-up build took: the build's time when no timed build had room.
+    warm_up_ms: f64,
+    /// The memory available when a timed build was left out for want of room (no later one is
+    /// tried).
+    no_room: Option<u64>,
 }
 
 /// One workload of a [`Pending`] structure: what a timed pass needs, and its samples.
@@ -108,23 +113,34 @@ fn runs_after(warm_up: Duration, trace_runs: usize) -> usize {
 }
 
 impl<'e> Pending<'e> {
-    pub(super) fn new(entry: &'e StructureEntry, built: Built, result: ResultEntry) -> Self {
+    pub(super) fn new(
+        entry: &'e StructureEntry,
+        built: Built,
+        warm_up_ms: f64,
+        result: ResultEntry,
+    ) -> Self {
         Pending {
             entry,
             built,
             result,
             jobs: Vec::new(),
             build_ms: Vec::new(),
+            warm_up_ms,
+            no_room: None,
         }
     }
 
     /// Round `r`: one timed build (the new structure is dropped outside the timed window) while
-    /// `r < build_runs`, and one timed pass of each workload that still has runs left.
+    /// `r < build_runs` and there is room for it ([`short_of_room`]), and one timed pass of each
+    /// workload that still has runs left.
     /// An `extra` round (past the fixed ones, see [`time_in_rounds`]) builds nothing and
     /// traces every workload that is not timed once.
     fn round(&mut self, r: usize, extra: bool, sr: &SceneRun, opts: &RunOptions) -> Result<()> {
         let mesh = &sr.scene.scene.mesh;
-        if !extra && r < opts.build_runs.max(1) {
+        if !extra && r < opts.build_runs.max(1) && self.no_room.is_none() {
+            self.no_room = short_of_room(self.result.memory_bytes, crate::memory::available());
+        }
+        if !extra && r < opts.build_runs.max(1) && self.no_room.is_none() {
             let ctx = BuildContext {
                 threads: opts.threads,
             };
@@ -158,14 +174,48 @@ impl<'e> Pending<'e> {
         Ok(())
     }
 
-    /// The result with its timings from the samples.
-    fn finish(mut self) -> ResultEntry {
+    /// The result with its timings from the samples, and a note when builds were left out.
+    fn finish(mut self, build_runs: usize) -> Timed {
+        let note = self.no_room.map(|available| {
+            let timed = match self.build_ms.len() {
+                0 => "its build time is the warm-up build's".to_string(),
+                n => format!("{n} of {build_runs} builds timed"),
+            };
+            format!(
+                "{} on {}: {timed}: timing another needs room for a second copy of its {} and the \
+                 build's working memory, and {} were available",
+                self.entry.name,
+                self.result.scene,
+                bytes(self.result.memory_bytes),
+                bytes(available)
+            )
+        });
+        if self.build_ms.is_empty() {
+            self.build_ms.push(self.warm_up_ms);
+        }
         self.result.build = Timing::from_samples(self.build_ms);
         for job in self.jobs {
             self.result.workloads[job.result_index].mqueries_per_s =
                 Throughput::from_samples(job.samples);
         }
-        self.result
+        (self.result, note)
+    }
+}
+
+/// A timed build is made beside the copy the passes trace, so it needs room for a second copy
+/// and for the build's working memory, taken as the copy's size again. Without that room
+/// (`available` bytes, when known) the build is left out and the run goes on, instead of the
+/// kernel killing it and losing every scene's results: returns the memory available then.
+fn short_of_room(memory_bytes: u64, available: Option<u64>) -> Option<u64> {
+    available.filter(|&a| memory_bytes.saturating_mul(2) > a)
+}
+
+/// Bytes for a note, in GB or MB.
+fn bytes(n: u64) -> String {
+    if n >= 1_000_000_000 {
+        format!("{:.1} GB", n as f64 / 1e9)
+    } else {
+        format!("{:.0} MB", n as f64 / 1e6)
     }
 }
 
@@ -177,13 +227,17 @@ pub(super) fn rounds(opts: &RunOptions) -> usize {
 /// The precision extra rounds aim for: every ratio's interval within ±2 % of it.
 const TARGET_HALF_WIDTH: f64 = 0.02;
 
+/// A structure's result with its timings, and a note when builds were left out.
+pub(super) type Timed = (ResultEntry, Option<String>);
+
 /// The most rounds a scene takes, fixed and extra together.
 const MAX_ROUNDS: usize = 1000;
 
 /// Times every pending structure in interleaved rounds and returns, in the order given, each
-/// structure's name with its result or what went wrong (a failed build or a panic in any round
-/// takes that structure out of the later rounds; the others go on). `None` when a graceful
-/// stop is asked for ([`crate::interrupt`]): checked before each structure's turn.
+/// structure's name with its result (and a note when builds were left out for want of memory)
+/// or what went wrong (a failed build or a panic in any round takes that structure out of the
+/// later rounds; the others go on). `None` when a graceful stop is asked for
+/// ([`crate::interrupt`]): checked before each structure's turn.
 ///
 /// With a time budget (`opts.time_budget`, seconds per structure and scene), the fixed rounds
 /// are followed by extra ones, traces only, as criterion and hyperfine adapt their sample
@@ -194,7 +248,7 @@ pub(super) fn time_in_rounds(
     pending: Vec<Pending<'_>>,
     sr: &SceneRun,
     opts: &RunOptions,
-) -> Option<Vec<(&'static str, Result<ResultEntry>)>> {
+) -> Option<Vec<(&'static str, Result<Timed>)>> {
     let n = pending.len();
     let mut failed: Vec<Option<anyhow::Error>> = (0..n).map(|_| None).collect();
     let mut spent = vec![Duration::ZERO; n];
@@ -231,7 +285,7 @@ pub(super) fn time_in_rounds(
         .into_iter()
         .zip(failed)
         .map(|(p, f)| match f {
-            None => (p.entry.name, Ok(p.finish())),
+            None => (p.entry.name, Ok(p.finish(opts.build_runs.max(1)))),
             Some(e) => (p.entry.name, Err(e)),
         })
         .collect();

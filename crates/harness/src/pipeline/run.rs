@@ -26,6 +26,7 @@ use raybench_accel::Accel;
 use raybench_accel::classify::Tolerance;
 use raybench_scenes::{SceneRequest, WhittedParams, Workload};
 use std::path::PathBuf;
+use std::time::Instant;
 
 /// Everything `raybench run` needs; the CLI fills it from flags and the suite manifest.
 #[derive(Clone, Debug)]
@@ -223,7 +224,10 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
             };
             for (structure, timed) in timed {
                 match timed {
-                    Ok(r) => report.results.push(r),
+                    Ok((r, note)) => {
+                        report.results.push(r);
+                        log.notes.extend(note);
+                    }
                     Err(e) => log.errors.push(format!("{structure} on {name}: {e:#}")),
                 }
             }
@@ -271,7 +275,9 @@ impl SceneRun<'_> {
         let ctx = BuildContext {
             threads: opts.threads,
         };
+        let start = Instant::now();
         let built = entry.build(s.mesh.clone(), &ctx)?;
+        let warm_up_ms = start.elapsed().as_secs_f64() * 1e3;
         let accel = built.accel.as_ref();
         let mut jobs = Vec::new();
         let mut workloads = Vec::new();
@@ -386,7 +392,7 @@ impl SceneRun<'_> {
             not_offered,
             primary_image,
         };
-        let mut pending = Pending::new(entry_of, built, result);
+        let mut pending = Pending::new(entry_of, built, warm_up_ms, result);
         pending.jobs = jobs;
         Ok(pending)
     }
