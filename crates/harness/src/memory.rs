@@ -1,16 +1,29 @@
 //! The machine's memory as `/proc/meminfo` gives it: the total, which bounds the counts a user
 //! may ask for ([`crate::cli::bounds`]), and what is available now, which decides whether a run
 //! may time one more build of a structure beside the copy it traces (`pipeline/rounds.rs`).
+//! What is available is capped by the process's control group, as in a container or a CI
+//! runner with a memory limit, where the kernel kills the process at the group's limit however
+//! much the machine has free.
+
+use std::path::{Path, PathBuf};
 
 /// Physical memory in bytes, or 8 GiB when it cannot be read.
 pub fn physical() -> u64 {
     meminfo("MemTotal:").unwrap_or(8 << 30)
 }
 
-/// Memory available for new allocations without swapping, in bytes (the kernel's own
-/// estimate), or `None` when it cannot be read.
+/// Memory available for new allocations without swapping, in bytes: the kernel's own
+/// estimate, or the room left under the control group's limit where that is less. `None` when
+/// neither can be read.
 pub fn available() -> Option<u64> {
-    meminfo("MemAvailable:")
+    let system = meminfo("MemAvailable:");
+    let group = std::fs::read_to_string("/proc/self/cgroup")
+        .ok()
+        .and_then(|text| group_room(&text, Path::new("/sys/fs/cgroup")));
+    match (system, group) {
+        (Some(s), Some(g)) => Some(s.min(g)),
+        (s, g) => s.or(g),
+    }
 }
 
 /// The value of one `/proc/meminfo` line, given in KiB there, in bytes.
@@ -23,6 +36,94 @@ fn parse(text: &str, key: &str) -> Option<u64> {
     let line = text.lines().find(|l| l.starts_with(key))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     kib.checked_mul(1024)
+}
+
+/// The least room under a memory limit over the process's control group and its ancestors
+/// (a parent's limit binds its children), from `/proc/self/cgroup`'s text and the cgroup file
+/// system mounted at `root`; `None` where no group has a limit. Version 2 groups keep
+/// `memory.max` and `memory.current`, version 1 groups `memory.limit_in_bytes` and
+/// `memory.usage_in_bytes` under the `memory` hierarchy.
+fn group_room(proc_self_cgroup: &str, root: &Path) -> Option<u64> {
+    let mut least: Option<u64> = None;
+    for line in proc_self_cgroup.lines() {
+        let mut fields = line.splitn(3, ':');
+        let (Some(id), Some(controllers), Some(path)) =
+            (fields.next(), fields.next(), fields.next())
+        else {
+            continue;
+        };
+        let (base, files) = if id == "0" && controllers.is_empty() {
+            (root.to_path_buf(), V2)
+        } else if controllers.split(',').any(|c| c == "memory") {
+            (root.join("memory"), V1)
+        } else {
+            continue;
+        };
+        for dir in ancestors(&base, path) {
+            let read = |name: &str| std::fs::read_to_string(dir.join(name)).ok();
+            let (Some(limit), Some(usage)) = (read(files.limit), read(files.usage)) else {
+                continue;
+            };
+            let stat = read("memory.stat").unwrap_or_default();
+            if let Some(room) = room(&limit, &usage, stat_value(&stat, files.inactive_file)) {
+                least = Some(least.map_or(room, |x| x.min(room)));
+            }
+        }
+    }
+    least
+}
+
+/// The files of one cgroup version: the limit, the usage, and the `memory.stat` key of the file
+/// cache the kernel would drop before it kills (the usage counts it).
+struct Files {
+    limit: &'static str,
+    usage: &'static str,
+    inactive_file: &'static str,
+}
+
+const V2: Files = Files {
+    limit: "memory.max",
+    usage: "memory.current",
+    inactive_file: "inactive_file",
+};
+
+const V1: Files = Files {
+    limit: "memory.limit_in_bytes",
+    usage: "memory.usage_in_bytes",
+    inactive_file: "total_inactive_file",
+};
+
+/// One `memory.stat` value (`key value` lines), 0 when absent.
+fn stat_value(stat: &str, key: &str) -> u64 {
+    stat.lines()
+        .find_map(|l| l.strip_prefix(key)?.strip_prefix(' ')?.trim().parse().ok())
+        .unwrap_or(0)
+}
+
+/// The group's directory under `base` and each of its parents up to `base` itself.
+fn ancestors(base: &Path, path: &str) -> Vec<PathBuf> {
+    let mut dir = base.to_path_buf();
+    let mut dirs = vec![dir.clone()];
+    for part in path
+        .split('/')
+        .filter(|p| !p.is_empty() && *p != "." && *p != "..")
+    {
+        dir.push(part);
+        dirs.push(dir.clone());
+    }
+    dirs
+}
+
+/// The room left under one group's limit, its inactive file cache counted as free (as the
+/// kubelet counts a container's working set): `None` when it has no limit (`max`, or version
+/// 1's "unlimited", a number near 2^63).
+fn room(limit: &str, usage: &str, inactive_file: u64) -> Option<u64> {
+    let limit: u64 = limit.trim().parse().ok()?;
+    if limit >= 1 << 62 {
+        return None;
+    }
+    let usage: u64 = usage.trim().parse().ok()?;
+    Some(limit.saturating_sub(usage.saturating_sub(inactive_file)))
 }
 
 #[cfg(test)]
@@ -47,5 +148,66 @@ mod tests {
     fn this_machine_says_how_much_is_available() {
         let available = available().expect("MemAvailable in /proc/meminfo");
         assert!(available <= physical(), "{available} available");
+    }
+
+    #[test]
+    fn a_limit_leaves_its_room_and_no_limit_none() {
+        assert_eq!(room("1000\n", "400\n", 0), Some(600));
+        assert_eq!(room("1000\n", "400\n", 100), Some(700));
+        assert_eq!(room("1000", "1200", 0), Some(0));
+        assert_eq!(room("1000", "300", 500), Some(1000));
+        assert_eq!(room("max\n", "400", 0), None);
+        assert_eq!(room("9223372036854771712\n", "400", 0), None);
+        assert_eq!(room("1000", "?", 0), None);
+        let stat = "active_file 7\ninactive_file 250\ntotal_inactive_file 90\n";
+        assert_eq!(stat_value(stat, "inactive_file"), 250);
+        assert_eq!(stat_value(stat, "total_inactive_file"), 90);
+        assert_eq!(stat_value(stat, "shmem"), 0);
+    }
+
+    /// A made-up cgroup file system in a temporary directory: the tightest limit of the group
+    /// and its parents counts, in either version's files; other controllers are ignored.
+    #[test]
+    fn the_tightest_group_on_the_path_bounds_the_room() {
+        let root = std::env::temp_dir().join(format!("raybench-cgroup-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let write = |dir: &Path, files: &[(&str, &str)]| {
+            std::fs::create_dir_all(dir).unwrap();
+            for (name, text) in files {
+                std::fs::write(dir.join(name), text).unwrap();
+            }
+        };
+        // Version 2: the parent allows 8,000 with 5,000 used; the group 6,000 with 1,000.
+        write(
+            &root,
+            &[("memory.max", "max\n"), ("memory.current", "9000\n")],
+        );
+        write(
+            &root.join("ci"),
+            &[("memory.max", "8000\n"), ("memory.current", "5000\n")],
+        );
+        write(
+            &root.join("ci/job"),
+            &[("memory.max", "6000\n"), ("memory.current", "1000\n")],
+        );
+        assert_eq!(group_room("0::/ci/job\n", &root), Some(3000));
+        // The parent's file cache, 2,000 of its usage, is room too.
+        write(&root.join("ci"), &[("memory.stat", "inactive_file 2000\n")]);
+        assert_eq!(group_room("0::/ci/job\n", &root), Some(5000));
+        assert_eq!(group_room("0::/\n", &root), None);
+        // Version 1: only the `memory` hierarchy counts.
+        let v1 = root.join("memory/docker/abc");
+        write(
+            &v1,
+            &[
+                ("memory.limit_in_bytes", "4000\n"),
+                ("memory.usage_in_bytes", "2500\n"),
+            ],
+        );
+        let text = "12:cpu,cpuacct:/docker/abc\n4:memory:/docker/abc\n0::/ci/job\n";
+        assert_eq!(group_room(text, &root), Some(1500));
+        assert_eq!(group_room("12:cpu:/docker/abc\n", &root), None);
+        assert_eq!(group_room("garbage\n", &root), None);
+        std::fs::remove_dir_all(&root).unwrap();
     }
 }
