@@ -1,29 +1,38 @@
 //! The machine's memory as `/proc/meminfo` gives it: the total, which bounds the counts a user
 //! may ask for ([`crate::cli::bounds`]), and what is available now, which decides whether a run
 //! may time one more build of a structure beside the copy it traces (`pipeline/rounds.rs`).
-//! What is available is capped by the process's control group, as in a container or a CI
-//! runner with a memory limit, where the kernel kills the process at the group's limit however
-//! much the machine has free.
+//! Both are capped by the process's control group, as in a container or a CI runner with a
+//! memory limit, where the kernel kills the process at the group's limit however much the
+//! machine has.
 
 use std::path::{Path, PathBuf};
 
-/// Physical memory in bytes, or 8 GiB when it cannot be read.
+/// Memory the process may use, in bytes: the machine's, or its control group's limit where
+/// that is less; 8 GiB when neither can be read.
 pub fn physical() -> u64 {
-    meminfo("MemTotal:").unwrap_or(8 << 30)
+    let machine = meminfo("MemTotal:");
+    let group = this_group().map(|g| g.limit);
+    least(machine, group).unwrap_or(8 << 30)
 }
 
 /// Memory available for new allocations without swapping, in bytes: the kernel's own
 /// estimate, or the room left under the control group's limit where that is less. `None` when
 /// neither can be read.
 pub fn available() -> Option<u64> {
-    let system = meminfo("MemAvailable:");
-    let group = std::fs::read_to_string("/proc/self/cgroup")
-        .ok()
-        .and_then(|text| group_room(&text, Path::new("/sys/fs/cgroup")));
-    match (system, group) {
-        (Some(s), Some(g)) => Some(s.min(g)),
-        (s, g) => s.or(g),
+    least(meminfo("MemAvailable:"), this_group().map(|g| g.room))
+}
+
+fn least(a: Option<u64>, b: Option<u64>) -> Option<u64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
     }
+}
+
+/// The process's control group, from `/proc/self/cgroup` and `/sys/fs/cgroup`.
+fn this_group() -> Option<Group> {
+    let text = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    group(&text, Path::new("/sys/fs/cgroup"))
 }
 
 /// The value of one `/proc/meminfo` line, given in KiB there, in bytes.
@@ -38,13 +47,20 @@ fn parse(text: &str, key: &str) -> Option<u64> {
     kib.checked_mul(1024)
 }
 
-/// The least room under a memory limit over the process's control group and its ancestors
-/// (a parent's limit binds its children), from `/proc/self/cgroup`'s text and the cgroup file
-/// system mounted at `root`; `None` where no group has a limit. Version 2 groups keep
+/// The tightest memory limit over a control group and its ancestors (a parent's limit binds
+/// its children), and the least room left under any of them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Group {
+    limit: u64,
+    room: u64,
+}
+
+/// The process's [`Group`], from `/proc/self/cgroup`'s text and the cgroup file system mounted
+/// at `root`; `None` where no group on the path has a limit. Version 2 groups keep
 /// `memory.max` and `memory.current`, version 1 groups `memory.limit_in_bytes` and
 /// `memory.usage_in_bytes` under the `memory` hierarchy.
-fn group_room(proc_self_cgroup: &str, root: &Path) -> Option<u64> {
-    let mut least: Option<u64> = None;
+fn group(proc_self_cgroup: &str, root: &Path) -> Option<Group> {
+    let mut tightest: Option<Group> = None;
     for line in proc_self_cgroup.lines() {
         let mut fields = line.splitn(3, ':');
         let (Some(id), Some(controllers), Some(path)) =
@@ -65,12 +81,19 @@ fn group_room(proc_self_cgroup: &str, root: &Path) -> Option<u64> {
                 continue;
             };
             let stat = read("memory.stat").unwrap_or_default();
-            if let Some(room) = room(&limit, &usage, stat_value(&stat, files.inactive_file)) {
-                least = Some(least.map_or(room, |x| x.min(room)));
-            }
+            let Some(g) = limited(&limit, &usage, stat_value(&stat, files.inactive_file)) else {
+                continue;
+            };
+            tightest = Some(match tightest {
+                None => g,
+                Some(t) => Group {
+                    limit: t.limit.min(g.limit),
+                    room: t.room.min(g.room),
+                },
+            });
         }
     }
-    least
+    tightest
 }
 
 /// The files of one cgroup version: the limit, the usage, and the `memory.stat` key of the file
@@ -114,16 +137,17 @@ fn ancestors(base: &Path, path: &str) -> Vec<PathBuf> {
     dirs
 }
 
-/// The room left under one group's limit, its inactive file cache counted as free (as the
-/// kubelet counts a container's working set): `None` when it has no limit (`max`, or version
-/// 1's "unlimited", a number near 2^63).
-fn room(limit: &str, usage: &str, inactive_file: u64) -> Option<u64> {
+/// One group's limit and the room left under it, its inactive file cache counted as free (as
+/// the kubelet counts a container's working set): `None` when it has no limit (`max`, or
+/// version 1's "unlimited", a number near 2^63) or a file does not parse.
+fn limited(limit: &str, usage: &str, inactive_file: u64) -> Option<Group> {
     let limit: u64 = limit.trim().parse().ok()?;
     if limit >= 1 << 62 {
         return None;
     }
     let usage: u64 = usage.trim().parse().ok()?;
-    Some(limit.saturating_sub(usage.saturating_sub(inactive_file)))
+    let room = limit.saturating_sub(usage.saturating_sub(inactive_file));
+    Some(Group { limit, room })
 }
 
 #[cfg(test)]
@@ -147,7 +171,15 @@ mod tests {
     #[cfg(target_os = "linux")]
     fn this_machine_says_how_much_is_available() {
         let available = available().expect("MemAvailable in /proc/meminfo");
-        assert!(available <= physical(), "{available} available");
+        let total = meminfo("MemTotal:").expect("MemTotal in /proc/meminfo");
+        assert!(
+            available <= total && physical() <= total,
+            "{available} available"
+        );
+    }
+
+    fn room(limit: &str, usage: &str, inactive_file: u64) -> Option<u64> {
+        limited(limit, usage, inactive_file).map(|g| g.room)
     }
 
     #[test]
@@ -190,11 +222,23 @@ mod tests {
             &root.join("ci/job"),
             &[("memory.max", "6000\n"), ("memory.current", "1000\n")],
         );
-        assert_eq!(group_room("0::/ci/job\n", &root), Some(3000));
+        assert_eq!(
+            group("0::/ci/job\n", &root),
+            Some(Group {
+                limit: 6000,
+                room: 3000
+            })
+        );
         // The parent's file cache, 2,000 of its usage, is room too.
         write(&root.join("ci"), &[("memory.stat", "inactive_file 2000\n")]);
-        assert_eq!(group_room("0::/ci/job\n", &root), Some(5000));
-        assert_eq!(group_room("0::/\n", &root), None);
+        assert_eq!(
+            group("0::/ci/job\n", &root),
+            Some(Group {
+                limit: 6000,
+                room: 5000
+            })
+        );
+        assert_eq!(group("0::/\n", &root), None);
         // Version 1: only the `memory` hierarchy counts.
         let v1 = root.join("memory/docker/abc");
         write(
@@ -205,9 +249,15 @@ mod tests {
             ],
         );
         let text = "12:cpu,cpuacct:/docker/abc\n4:memory:/docker/abc\n0::/ci/job\n";
-        assert_eq!(group_room(text, &root), Some(1500));
-        assert_eq!(group_room("12:cpu:/docker/abc\n", &root), None);
-        assert_eq!(group_room("garbage\n", &root), None);
+        assert_eq!(
+            group(text, &root),
+            Some(Group {
+                limit: 4000,
+                room: 1500
+            })
+        );
+        assert_eq!(group("12:cpu:/docker/abc\n", &root), None);
+        assert_eq!(group("garbage\n", &root), None);
         std::fs::remove_dir_all(&root).unwrap();
     }
 }
