@@ -22,6 +22,16 @@ pub fn available() -> Option<u64> {
     least(meminfo("MemAvailable:"), this_group().map(|g| g.room))
 }
 
+/// An amount of memory for a message, in GiB with one decimal (in e-notation past a million).
+pub fn gib(bytes: f64) -> String {
+    let g = bytes / (1u64 << 30) as f64;
+    if g < 1e6 {
+        format!("{g:.1} GiB")
+    } else {
+        format!("{g:.1e} GiB")
+    }
+}
+
 fn least(a: Option<u64>, b: Option<u64>) -> Option<u64> {
     match (a, b) {
         (Some(a), Some(b)) => Some(a.min(b)),

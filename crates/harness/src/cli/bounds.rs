@@ -3,6 +3,7 @@
 //! failed allocation an hour later, and a count that means nothing (0 timed runs) or only
 //! measures the operating system (100,000 threads) is refused with the reason.
 
+use crate::memory::gib;
 use anyhow::{Result, bail};
 
 /// Bytes a run holds per ray of one ray workload while a scene is measured: the ray (44
@@ -25,15 +26,6 @@ const MEMORY_SHARE: f64 = 0.5;
 pub const MAX_RUNS: usize = 1000;
 /// Most worker threads per core: oversubscription can be measured, a thread storm cannot.
 pub const THREADS_PER_CORE: usize = 8;
-
-fn gib(bytes: f64) -> String {
-    let g = bytes / (1u64 << 30) as f64;
-    if g < 1e6 {
-        format!("{g:.1} GiB")
-    } else {
-        format!("{g:.1e} GiB")
-    }
-}
 
 /// Refuses `--rays n` when the ray workloads would not fit in memory. `ray_workloads` counts
 /// them; `whitted` says whether one of them is Whitted's.

@@ -282,10 +282,10 @@ fn check_picture_memory(width: u32, structures: usize) -> Result<()> {
     let have = crate::memory::physical();
     anyhow::ensure!(
         need <= have / 2,
-        "--picture-width {width} needs about {:.1} GiB per scene with {structures} structures, \
-         more than half of this machine's {:.1} GiB: give a smaller width or --no-images",
-        need as f64 / f64::from(1u32 << 30),
-        have as f64 / f64::from(1u32 << 30)
+        "--picture-width {width} needs about {} per scene with {structures} structures, \
+         more than half of this machine's {}: give a smaller width or --no-images",
+        crate::memory::gib(need as f64),
+        crate::memory::gib(have as f64)
     );
     Ok(())
 }

@@ -13,6 +13,7 @@ use super::measure::{Answers, LONG_PASS, point_pass, trace_pass};
 use super::run::RunOptions;
 use super::workers::catch_panic;
 use super::workloads::SceneRun;
+use crate::memory::gib;
 use crate::registry::{BuildContext, Built, StructureEntry};
 use crate::report::interval::{median_with_interval, paired_ratios};
 use crate::report::run::{ResultEntry, Throughput, Timing};
@@ -137,10 +138,11 @@ impl<'e> Pending<'e> {
     /// traces every workload that is not timed once.
     fn round(&mut self, r: usize, extra: bool, sr: &SceneRun, opts: &RunOptions) -> Result<()> {
         let mesh = &sr.scene.scene.mesh;
-        if !extra && r < opts.build_runs.max(1) && self.no_room.is_none() {
+        let builds = !extra && r < opts.build_runs.max(1) && self.no_room.is_none();
+        if builds {
             self.no_room = short_of_room(self.result.memory_bytes, crate::memory::available());
         }
-        if !extra && r < opts.build_runs.max(1) && self.no_room.is_none() {
+        if builds && self.no_room.is_none() {
             let ctx = BuildContext {
                 threads: opts.threads,
             };
@@ -186,8 +188,8 @@ impl<'e> Pending<'e> {
                  build's working memory, and {} were available",
                 self.entry.name,
                 self.result.scene,
-                bytes(self.result.memory_bytes),
-                bytes(available)
+                gib(self.result.memory_bytes as f64),
+                gib(available as f64)
             )
         });
         if self.build_ms.is_empty() {
@@ -208,15 +210,6 @@ impl<'e> Pending<'e> {
 /// kernel killing it and losing every scene's results: returns the memory available then.
 fn short_of_room(memory_bytes: u64, available: Option<u64>) -> Option<u64> {
     available.filter(|&a| memory_bytes.saturating_mul(2) > a)
-}
-
-/// Bytes for a note, in GB or MB.
-fn bytes(n: u64) -> String {
-    if n >= 1_000_000_000 {
-        format!("{:.1} GB", n as f64 / 1e9)
-    } else {
-        format!("{:.0} MB", n as f64 / 1e6)
-    }
 }
 
 /// How many rounds a run's settings take: enough for every timed build and pass.
