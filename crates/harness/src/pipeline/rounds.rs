@@ -8,6 +8,13 @@
 //!
 //! The price is memory: all of a scene's structures (and their prepared rays) are alive
 //! together, where measuring one after the other held one at a time.
+//!
+//! Each timed build replaces the copy the passes trace: that copy is dropped just before the
+//! clock starts. Every build then starts from the same state, the memory its own last copy
+//! freed, whatever ran before it in the round. Kept beside the traced copy instead, a build's
+//! time depended on its neighbour: Embree's builds fault their memory in from the kernel, and
+//! run far faster on pages their own last copy just freed than on pages another structure
+//! freed, so the rotation timed them fast in some rounds and slow in others.
 
 use super::measure::{Answers, LONG_PASS, point_pass, trace_pass};
 use super::run::RunOptions;
@@ -17,15 +24,17 @@ use crate::memory::gib;
 use crate::registry::{BuildContext, Built, StructureEntry};
 use crate::report::interval::{median_with_interval, paired_ratios};
 use crate::report::run::{ResultEntry, Throughput, Timing};
-use anyhow::Result;
-use raybench_accel::{PointHit, PreparedRays};
+use anyhow::{Result, bail};
+use raybench_accel::{Accel, PointHit, PreparedRays};
 use std::time::{Duration, Instant};
 
 /// One structure of a scene, built and checked, waiting for its timed passes.
 pub(super) struct Pending<'e> {
     pub entry: &'e StructureEntry,
-    /// The warm-up build: the one every pass traces.
-    pub built: Built,
+    /// The copy every pass traces: the warm-up build, then each timed build in its place.
+    /// `None` only while a timed build runs, or after one failed (which ends the structure's
+    /// rounds).
+    built: Option<Built>,
     /// Everything but the timings, which [`finish`](Pending::finish) fills in.
     pub result: ResultEntry,
     pub jobs: Vec<Job>,
@@ -122,7 +131,7 @@ impl<'e> Pending<'e> {
     ) -> Self {
         Pending {
             entry,
-            built,
+            built: Some(built),
             result,
             jobs: Vec::new(),
             build_ms: Vec::new(),
@@ -131,9 +140,15 @@ impl<'e> Pending<'e> {
         }
     }
 
-    /// Round `r`: one timed build (the new structure is dropped outside the timed window) while
-    /// `r < build_runs` and there is room for it ([`short_of_room`]), and one timed pass of each
-    /// workload that still has runs left.
+    /// The warm-up build, before the rounds begin.
+    pub(super) fn warm_up(&self) -> Option<&dyn Accel> {
+        self.built.as_ref().map(|b| b.accel.as_ref())
+    }
+
+    /// Round `r`: one timed build while `r < build_runs` and there is room for it
+    /// ([`short_of_room`]), which replaces the copy the passes trace (dropped outside the
+    /// timed window, just before it), and one timed pass of each workload that still has runs
+    /// left.
     /// An `extra` round (past the fixed ones, see [`time_in_rounds`]) builds nothing and
     /// traces every workload that is not timed once.
     fn round(&mut self, r: usize, extra: bool, sr: &SceneRun, opts: &RunOptions) -> Result<()> {
@@ -146,12 +161,19 @@ impl<'e> Pending<'e> {
             let ctx = BuildContext {
                 threads: opts.threads,
             };
+            drop(self.built.take());
             let start = Instant::now();
             let next = self.entry.build(mesh.clone(), &ctx)?;
             self.build_ms.push(start.elapsed().as_secs_f64() * 1e3);
-            drop(next);
+            self.built = Some(next);
         }
-        let accel = self.built.accel.as_ref();
+        // The checks ran on the warm-up build; a timed build stands for it, since each of our
+        // builders gives the same structure on every build (the tests assert it) and Embree's
+        // is the same scene built with the same settings.
+        let Some(built) = &self.built else {
+            bail!("no structure to trace: its timed build failed");
+        };
+        let accel = built.accel.as_ref();
         let runs_now = |j: &Job| if extra { j.runs > 1 } else { r < j.runs };
         for job in self.jobs.iter_mut().filter(|j| runs_now(j)) {
             let (queries, took) = match &mut job.kind {
@@ -184,7 +206,7 @@ impl<'e> Pending<'e> {
                 n => format!("{n} of {build_runs} builds timed"),
             };
             format!(
-                "{} on {}: {timed}: timing another needs room for a second copy of its {} and the \
+                "{} on {}: {timed}: timing another needs room for a new copy of its {} and the \
                  build's working memory, and {} were available",
                 self.entry.name,
                 self.result.scene,
@@ -204,10 +226,11 @@ impl<'e> Pending<'e> {
     }
 }
 
-/// A timed build is made beside the copy the passes trace, so it needs room for a second copy
-/// and for the build's working memory, taken as the copy's size again. Without that room
-/// (`available` bytes, when known) the build is left out and the run goes on, instead of the
-/// kernel killing it and losing every scene's results: returns the memory available then.
+/// A timed build needs room for its new copy and for its working memory, taken as the copy's
+/// size again. The copy it replaces is dropped first, but an allocator may keep what it frees,
+/// so that copy is not counted as room. Without that room (`available` bytes, when known) the
+/// build is left out and the passes go on tracing the copy they have, instead of the kernel
+/// killing the run and losing every scene's results: returns the memory available then.
 fn short_of_room(memory_bytes: u64, available: Option<u64>) -> Option<u64> {
     available.filter(|&a| memory_bytes.saturating_mul(2) > a)
 }

@@ -203,9 +203,9 @@ pub fn run_with(registry: &Registry, opts: &RunOptions, scenes: &[SceneRequest])
                         continue;
                     }
                 };
-                if let Some((pics, pool)) = pictures.as_mut() {
+                if let (Some((pics, pool)), Some(accel)) = (pictures.as_mut(), p.warm_up()) {
                     let mesh = &scene.scene.mesh;
-                    let added = catch_panic(|| pool.install(|| pics.add(entry.name, p.built.accel.as_ref(), mesh, sr.reference.as_ref(), &tol)));
+                    let added = catch_panic(|| pool.install(|| pics.add(entry.name, accel, mesh, sr.reference.as_ref(), &tol)));
                     if let Err(e) = added {
                         log.errors.push(format!("pictures of {} on {name}: {e:#}", entry.name));
                     }

@@ -1,6 +1,7 @@
 //! Interleaved rounds: every timed pass is kept, ratios come with intervals, with a time
-//! budget the extra rounds keep the reference paired with everyone who takes part, and a build
-//! is timed again only while a second copy of the structure fits in memory.
+//! budget the extra rounds keep the reference paired with everyone who takes part, each timed
+//! build replaces the copy the passes trace, and a build is timed again only while its new copy
+//! fits in memory beside the old.
 
 use crate::common;
 
@@ -62,47 +63,72 @@ fn samples_intervals_and_extra_rounds_stay_paired() {
     assert_eq!(report.run.time_budget_s, Some(0.3));
 }
 
-/// How many times [`Huge`] was built.
-static HUGE_BUILDS: AtomicUsize = AtomicUsize::new(0);
+/// Per kind of [`Counted`] (0: its true size, 1: claiming an exabyte, so that no machine has
+/// room for another copy): how many were built, how many are alive, and the most alive at once.
+static BUILDS: [AtomicUsize; 2] = [AtomicUsize::new(0), AtomicUsize::new(0)];
+static LIVE: [AtomicUsize; 2] = [AtomicUsize::new(0), AtomicUsize::new(0)];
+static MOST: [AtomicUsize; 2] = [AtomicUsize::new(0), AtomicUsize::new(0)];
 
-/// A binary BVH that claims an exabyte of memory: no machine has room for a second copy.
+/// A binary BVH that counts its copies, and may claim an exabyte of memory.
 #[derive(Debug)]
-struct Huge(Bvh);
+struct Counted {
+    bvh: Bvh,
+    huge: bool,
+}
 
-impl Accel for Huge {
-    type Params = BvhParams;
-    fn build(mesh: Arc<TriangleMesh>, p: &BvhParams) -> Result<Huge, BuildError> {
-        HUGE_BUILDS.fetch_add(1, Ordering::SeqCst);
-        Ok(Huge(Bvh::build(mesh, p)?))
+impl Drop for Counted {
+    fn drop(&mut self) {
+        LIVE[self.huge as usize].fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+impl Accel for Counted {
+    /// The BVH's parameters, and whether to claim an exabyte.
+    type Params = (BvhParams, bool);
+    fn build(
+        mesh: Arc<TriangleMesh>,
+        (p, huge): &(BvhParams, bool),
+    ) -> Result<Counted, BuildError> {
+        let bvh = Bvh::build(mesh, p)?;
+        let i = *huge as usize;
+        BUILDS[i].fetch_add(1, Ordering::SeqCst);
+        let live = LIVE[i].fetch_add(1, Ordering::SeqCst) + 1;
+        MOST[i].fetch_max(live, Ordering::SeqCst);
+        Ok(Counted { bvh, huge: *huge })
     }
     fn name(&self) -> &str {
-        "huge"
+        "counted"
     }
     fn intersect(&self, r: &Ray) -> Option<Hit> {
-        self.0.intersect(r)
+        self.bvh.intersect(r)
     }
     fn occluded(&self, r: &Ray) -> bool {
-        self.0.occluded(r)
+        self.bvh.occluded(r)
     }
     fn intersect_counted(&self, r: &Ray, c: &mut Counters) -> Option<Hit> {
-        self.0.intersect_counted(r, c)
+        self.bvh.intersect_counted(r, c)
     }
     fn occluded_counted(&self, r: &Ray, c: &mut Counters) -> bool {
-        self.0.occluded_counted(r, c)
+        self.bvh.occluded_counted(r, c)
     }
     fn closest_point(&self, p: Vec3, radius: f32) -> Option<PointHit> {
-        self.0.closest_point(p, radius)
+        self.bvh.closest_point(p, radius)
     }
     fn closest_point_counted(&self, p: Vec3, radius: f32, c: &mut Counters) -> Option<PointHit> {
-        self.0.closest_point_counted(p, radius, c)
+        self.bvh.closest_point_counted(p, radius, c)
     }
     fn build_stats(&self) -> BuildStats {
-        self.0.build_stats()
+        self.bvh.build_stats()
     }
     fn memory(&self) -> Memory {
-        Memory {
-            nodes: 1 << 60,
-            ..self.0.memory()
+        let m = self.bvh.memory();
+        if self.huge {
+            Memory {
+                nodes: 1 << 60,
+                ..m
+            }
+        } else {
+            m
         }
     }
 }
@@ -111,10 +137,10 @@ impl Accel for Huge {
 fn a_build_with_no_room_for_a_second_copy_is_not_timed_again_and_the_report_says_so() {
     let mut registry = Registry::builtin();
     registry
-        .register::<Huge>(
+        .register::<Counted>(
             "huge",
             "a binary BVH claiming an exabyte",
-            BvhParams::binned(),
+            (BvhParams::binned(), true),
         )
         .unwrap();
     let opts = RunOptions {
@@ -132,7 +158,7 @@ fn a_build_with_no_room_for_a_second_copy_is_not_timed_again_and_the_report_says
     assert_eq!(report.mismatches(), 0);
     let result = |name: &str| report.results.iter().find(|r| r.structure == name).unwrap();
     // Built once, for the checks; that build's time stands for it.
-    assert_eq!(HUGE_BUILDS.load(Ordering::SeqCst), 1);
+    assert_eq!(BUILDS[1].load(Ordering::SeqCst), 1);
     let huge = result("huge");
     assert_eq!(huge.build.samples_ms.len(), 1);
     assert!(huge.build.median_ms > 0.0);
@@ -152,4 +178,43 @@ fn a_build_with_no_room_for_a_second_copy_is_not_timed_again_and_the_report_says
         note.contains("its build time is the warm-up build's") && note.contains("available"),
         "{note}"
     );
+}
+
+#[test]
+fn each_timed_build_replaces_the_traced_copy_so_one_copy_is_alive_at_a_time() {
+    let mut registry = Registry::builtin();
+    registry
+        .register::<Counted>(
+            "tally",
+            "a binary BVH counting its copies",
+            (BvhParams::binned(), false),
+        )
+        .unwrap();
+    let opts = RunOptions {
+        workloads: vec![Workload::Primary, Workload::Shadow],
+        rays: 500,
+        build_runs: 4,
+        trace_runs: 5,
+        images: false,
+        reference: "bvh-binned".into(),
+        ..common::options(&["tally", "bvh-binned"])
+    };
+    let scenes = [SceneRequest::Spec("sphere:triangles=1000".into())];
+    let report = run_with(&registry, &opts, &scenes).unwrap();
+    assert!(report.errors.is_empty(), "{:?}", report.errors);
+    assert_eq!(report.mismatches(), 0);
+    let tally = report.results.iter().find(|r| r.structure == "tally");
+    let tally = tally.expect("tally in the report");
+    assert_eq!(tally.build.samples_ms.len(), 4);
+    assert!(
+        tally
+            .workloads
+            .iter()
+            .all(|w| w.mqueries_per_s.samples.len() == 5)
+    );
+    // The warm-up build and four timed ones, each dropped before the next was made, and the
+    // last dropped when the scene was done.
+    assert_eq!(BUILDS[0].load(Ordering::SeqCst), 5);
+    assert_eq!(MOST[0].load(Ordering::SeqCst), 1);
+    assert_eq!(LIVE[0].load(Ordering::SeqCst), 0);
 }
