@@ -77,7 +77,7 @@ fn main() {
         let accels: Vec<Box<dyn Accel>> = entries
             .iter()
             .map(|e| {
-                let ctx = BuildContext { threads: 2 };
+                let ctx = BuildContext::new(2);
                 two.install(|| e.build(mesh.clone(), &ctx).expect("builds").accel)
             })
             .collect();

@@ -185,7 +185,7 @@ pub fn replay_with(
     let scene = raybench_scenes::resolve(scene_spec, seed)
         .with_context(|| format!("scene '{scene_spec}'"))?;
     let mesh = scene.mesh.clone();
-    let ctx = BuildContext { threads: 1 };
+    let ctx = BuildContext::new(1);
     let tol = Tolerance::default();
     let mut built: Vec<(String, Box<dyn Accel>)> = Vec::new();
     for e in &entries {

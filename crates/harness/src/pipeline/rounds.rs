@@ -158,9 +158,7 @@ impl<'e> Pending<'e> {
             self.no_room = short_of_room(self.result.memory_bytes, crate::memory::available());
         }
         if builds && self.no_room.is_none() {
-            let ctx = BuildContext {
-                threads: opts.threads,
-            };
+            let ctx = BuildContext::new(opts.threads);
             drop(self.built.take());
             let start = Instant::now();
             let next = self.entry.build(mesh.clone(), &ctx)?;

@@ -272,9 +272,7 @@ impl SceneRun<'_> {
         mut dump: Option<&mut DumpDir>,
     ) -> Result<Pending<'e>> {
         let s = &self.scene.scene;
-        let ctx = BuildContext {
-            threads: opts.threads,
-        };
+        let ctx = BuildContext::new(opts.threads);
         let start = Instant::now();
         let built = entry.build(s.mesh.clone(), &ctx)?;
         let warm_up_ms = start.elapsed().as_secs_f64() * 1e3;

@@ -64,7 +64,7 @@ impl<'a> SceneRun<'a> {
         reference_entry: &StructureEntry,
     ) -> Result<SceneRun<'a>> {
         let s = &scene.scene;
-        let ctx = BuildContext { threads };
+        let ctx = BuildContext::new(threads);
         let reference = reference_entry.build(s.mesh.clone(), &ctx)?.accel;
         let (points, rays): (Vec<Workload>, Vec<Workload>) =
             workloads.iter().partition(|w| w.is_point_query());

@@ -79,7 +79,7 @@ fn a_dump_matches_the_report_and_a_re_trace() {
         let accel = Registry::builtin()
             .find(&e.structure)
             .unwrap()
-            .build(mesh.clone(), &BuildContext { threads: 1 })
+            .build(mesh.clone(), &BuildContext::new(1))
             .unwrap()
             .accel;
         for record in dump.records.iter().step_by(37) {

@@ -2,6 +2,7 @@
 //! compiled into and linked with one test binary instead of twenty (each about 55 MB).
 
 mod adversarial_scenes;
+mod build_limits;
 mod claims;
 mod cli;
 mod common;

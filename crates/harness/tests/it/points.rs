@@ -125,7 +125,7 @@ fn batch_answers_are_identical_on_one_and_two_threads_and_a_wrong_answer_is_a_mi
         PointWorkload::Near.generate(&mesh, 1000, 7),
         "seeded"
     );
-    let ctx = BuildContext { threads: 2 };
+    let ctx = BuildContext::new(2);
     let grid = Registry::builtin()
         .find("grid")
         .unwrap()

@@ -47,7 +47,7 @@ impl<'a> SceneReferences<'a> {
         entries: &[StructureEntry; 3],
         scene: &'a LoadedScene,
     ) -> Result<SceneReferences<'a>> {
-        let ctx = BuildContext { threads: o.threads };
+        let ctx = BuildContext::new(o.threads);
         let [medium, robust, brute] = entries;
         let counts = QueryCounts {
             rays: o.rays,

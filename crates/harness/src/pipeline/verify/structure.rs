@@ -34,9 +34,7 @@ pub(super) struct Checker<'a> {
 
 impl Checker<'_> {
     fn ctx(&self) -> BuildContext {
-        BuildContext {
-            threads: self.opts.threads,
-        }
+        BuildContext::new(self.opts.threads)
     }
 
     /// Builds one structure and checks it on every workload of the scene.

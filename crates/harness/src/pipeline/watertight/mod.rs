@@ -91,9 +91,7 @@ fn count_misses(
     aimed: &AimedRays,
     opts: &WatertightOptions,
 ) -> Result<Tally> {
-    let ctx = BuildContext {
-        threads: opts.threads,
-    };
+    let ctx = BuildContext::new(opts.threads);
     let accel = entry.build(mesh.clone(), &ctx)?.accel;
     let n = aimed.rays.len();
     let indices: Vec<usize> = if entry.is_exhaustive() {
