@@ -12,9 +12,9 @@
 //! Each timed build replaces the copy the passes trace: that copy is dropped just before the
 //! clock starts. Every build then starts from the same state, the memory its own last copy
 //! freed, whatever ran before it in the round. Kept beside the traced copy instead, a build's
-//! time depended on its neighbour: Embree's builds fault their memory in from the kernel, and
-//! run far faster on pages their own last copy just freed than on pages another structure
-//! freed, so the rotation timed them fast in some rounds and slow in others.
+//! time would depend on its neighbour: Embree's builds fault their memory in from the kernel,
+//! and run far faster on pages their own last copy just freed than on pages another structure
+//! freed, so the rotation would time them fast in some rounds and slow in others.
 
 use super::measure::{Answers, LONG_PASS, point_pass, trace_pass};
 use super::run::RunOptions;
