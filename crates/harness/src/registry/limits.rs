@@ -13,11 +13,14 @@ use raybench_bvh::{BvhParams, WideParams};
 use raybench_grid::{Grid2Params, GridParams, SkipGridParams};
 use raybench_kdtree::KdParams;
 use raybench_octree::OctreeParams;
+use std::sync::OnceLock;
 
 /// Half of this machine's memory (or of its cgroup's limit, where lower), at most the 8 GiB
-/// every builder defaults to.
+/// every builder defaults to. Read once per process: the machine's memory does not change
+/// during a run, and every build asks.
 pub fn for_this_machine() -> u64 {
-    (crate::memory::physical() / 2).min(BvhParams::MEMORY_LIMIT)
+    static LIMIT: OnceLock<u64> = OnceLock::new();
+    *LIMIT.get_or_init(|| (crate::memory::physical() / 2).min(BvhParams::MEMORY_LIMIT))
 }
 
 /// Parameters with a memory limit that a [`BuildContext`] may lower.

@@ -5,11 +5,12 @@
 
 use crate::common;
 
-use raybench_accel::{Accel, BuildError, BuildStats, Counters, Hit, Memory, PointHit};
+use raybench_accel::{Accel, BuildError, BuildStats, CounterSink, Hit, Memory, PointHit, Walk};
 use raybench_bvh::{Bvh, BvhParams};
 use raybench_geom::{Ray, TriangleMesh, Vec3};
 use raybench_harness::Registry;
 use raybench_harness::pipeline::run::{RunOptions, run, run_with};
+use raybench_harness::report::run::Report;
 use raybench_scenes::{SceneRequest, Workload};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -99,24 +100,7 @@ impl Accel for Counted {
     fn name(&self) -> &str {
         "counted"
     }
-    fn intersect(&self, r: &Ray) -> Option<Hit> {
-        self.bvh.intersect(r)
-    }
-    fn occluded(&self, r: &Ray) -> bool {
-        self.bvh.occluded(r)
-    }
-    fn intersect_counted(&self, r: &Ray, c: &mut Counters) -> Option<Hit> {
-        self.bvh.intersect_counted(r, c)
-    }
-    fn occluded_counted(&self, r: &Ray, c: &mut Counters) -> bool {
-        self.bvh.occluded_counted(r, c)
-    }
-    fn closest_point(&self, p: Vec3, radius: f32) -> Option<PointHit> {
-        self.bvh.closest_point(p, radius)
-    }
-    fn closest_point_counted(&self, p: Vec3, radius: f32, c: &mut Counters) -> Option<PointHit> {
-        self.bvh.closest_point_counted(p, radius, c)
-    }
+    raybench_accel::walk_queries!();
     fn build_stats(&self) -> BuildStats {
         self.bvh.build_stats()
     }
@@ -133,29 +117,46 @@ impl Accel for Counted {
     }
 }
 
-#[test]
-fn a_build_with_no_room_for_a_second_copy_is_not_timed_again_and_the_report_says_so() {
+/// The walk is the BVH's.
+impl Walk for Counted {
+    fn walk_ray<const ANY_HIT: bool, C: CounterSink>(&self, ray: &Ray, c: &mut C) -> Option<Hit> {
+        self.bvh.walk_ray::<ANY_HIT, C>(ray, c)
+    }
+    fn walk_point<C: CounterSink>(&self, p: Vec3, max_radius: f32, c: &mut C) -> Option<PointHit> {
+        self.bvh.walk_point(p, max_radius, c)
+    }
+}
+
+/// A run of a [`Counted`] BVH registered as `name` (an exabyte claimed when `huge`) against
+/// `bvh-binned`, on a small sphere: its report, checked to have no errors or mismatches.
+fn run_counted(name: &'static str, huge: bool, build_runs: usize, trace_runs: usize) -> Report {
     let mut registry = Registry::builtin();
     registry
         .register::<Counted>(
-            "huge",
-            "a binary BVH claiming an exabyte",
-            (BvhParams::binned(), true),
+            name,
+            "a binary BVH counting its copies",
+            (BvhParams::binned(), huge),
         )
         .unwrap();
     let opts = RunOptions {
         workloads: vec![Workload::Primary, Workload::Shadow],
         rays: 500,
-        build_runs: 3,
-        trace_runs: 3,
+        build_runs,
+        trace_runs,
         images: false,
         reference: "bvh-binned".into(),
-        ..common::options(&["huge", "bvh-binned"])
+        ..common::options(&[name, "bvh-binned"])
     };
     let scenes = [SceneRequest::Spec("sphere:triangles=1000".into())];
     let report = run_with(&registry, &opts, &scenes).unwrap();
     assert!(report.errors.is_empty(), "{:?}", report.errors);
     assert_eq!(report.mismatches(), 0);
+    report
+}
+
+#[test]
+fn a_build_with_no_room_for_a_second_copy_is_not_timed_again_and_the_report_says_so() {
+    let report = run_counted("huge", true, 3, 3);
     let result = |name: &str| report.results.iter().find(|r| r.structure == name).unwrap();
     // Built once, for the checks; that build's time stands for it.
     assert_eq!(BUILDS[1].load(Ordering::SeqCst), 1);
@@ -182,27 +183,7 @@ fn a_build_with_no_room_for_a_second_copy_is_not_timed_again_and_the_report_says
 
 #[test]
 fn each_timed_build_replaces_the_traced_copy_so_one_copy_is_alive_at_a_time() {
-    let mut registry = Registry::builtin();
-    registry
-        .register::<Counted>(
-            "tally",
-            "a binary BVH counting its copies",
-            (BvhParams::binned(), false),
-        )
-        .unwrap();
-    let opts = RunOptions {
-        workloads: vec![Workload::Primary, Workload::Shadow],
-        rays: 500,
-        build_runs: 4,
-        trace_runs: 5,
-        images: false,
-        reference: "bvh-binned".into(),
-        ..common::options(&["tally", "bvh-binned"])
-    };
-    let scenes = [SceneRequest::Spec("sphere:triangles=1000".into())];
-    let report = run_with(&registry, &opts, &scenes).unwrap();
-    assert!(report.errors.is_empty(), "{:?}", report.errors);
-    assert_eq!(report.mismatches(), 0);
+    let report = run_counted("tally", false, 4, 5);
     let tally = report.results.iter().find(|r| r.structure == "tally");
     let tally = tally.expect("tally in the report");
     assert_eq!(tally.build.samples_ms.len(), 4);
