@@ -107,14 +107,33 @@ impl Memory {
 
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
+    /// The build would pass its memory limit, by an estimate made before allocating.
     #[error(
-        "scene too large: the build would need about {needed_bytes} bytes, limit {limit_bytes}"
+        "scene too large: the build would need about {}, over its memory limit of {}",
+        amount(*.needed_bytes),
+        amount(*.limit_bytes)
     )]
     TooLarge { needed_bytes: u64, limit_bytes: u64 },
     #[error("unsupported input: {0}")]
     Unsupported(String),
     #[error("backend error: {0}")]
     Backend(String),
+}
+
+/// An amount of memory for a message: in the largest binary unit that keeps it at 1 or more,
+/// with two decimals, then the exact count of bytes, so that a need just past a limit still
+/// reads as larger than it.
+fn amount(bytes: u64) -> String {
+    const UNITS: [(&str, u32); 3] = [("GiB", 30), ("MiB", 20), ("KiB", 10)];
+    match UNITS.iter().find(|&&(_, shift)| bytes >> shift > 0) {
+        Some(&(unit, shift)) => {
+            format!(
+                "{:.2} {unit} ({bytes} bytes)",
+                bytes as f64 / (1u64 << shift) as f64
+            )
+        }
+        None => format!("{bytes} bytes"),
+    }
 }
 
 /// Rays converted into a structure's own layout, outside any timed region (see
@@ -239,4 +258,33 @@ pub fn build_dyn<A: Accel + 'static>(
     params: &A::Params,
 ) -> Result<Box<dyn Accel>, BuildError> {
     Ok(Box::new(A::build(mesh, params)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A need just past its limit reads as larger than the limit; small amounts stay in bytes.
+    #[test]
+    fn too_large_names_both_amounts_in_units_and_bytes() {
+        let e = BuildError::TooLarge {
+            needed_bytes: 2_147_542_592,
+            limit_bytes: 2 << 30,
+        };
+        assert_eq!(
+            e.to_string(),
+            "scene too large: the build would need about 2.00 GiB (2147542592 bytes), \
+             over its memory limit of 2.00 GiB (2147483648 bytes)"
+        );
+        let e = BuildError::TooLarge {
+            needed_bytes: 5 << 20,
+            limit_bytes: 4096,
+        };
+        assert_eq!(
+            e.to_string(),
+            "scene too large: the build would need about 5.00 MiB (5242880 bytes), \
+             over its memory limit of 4.00 KiB (4096 bytes)"
+        );
+        assert_eq!(amount(1023), "1023 bytes");
+    }
 }
