@@ -114,6 +114,17 @@ pub enum BuildError {
         amount(*.limit_bytes)
     )]
     TooLarge { needed_bytes: u64, limit_bytes: u64 },
+    /// A build that cannot estimate its memory ahead (Embree's) was refused the allocation that
+    /// would have taken it to `reached_bytes`, past its memory limit: it needs at least that.
+    #[error(
+        "scene too large: the build was refused memory at {}, past its memory limit of {}",
+        amount(*.reached_bytes),
+        amount(*.limit_bytes)
+    )]
+    MemoryLimitReached {
+        reached_bytes: u64,
+        limit_bytes: u64,
+    },
     #[error("unsupported input: {0}")]
     Unsupported(String),
     #[error("backend error: {0}")]
@@ -284,6 +295,15 @@ mod tests {
             e.to_string(),
             "scene too large: the build would need about 5.00 MiB (5242880 bytes), \
              over its memory limit of 4.00 KiB (4096 bytes)"
+        );
+        let e = BuildError::MemoryLimitReached {
+            reached_bytes: 1_073_847_228,
+            limit_bytes: 1 << 30,
+        };
+        assert_eq!(
+            e.to_string(),
+            "scene too large: the build was refused memory at 1.00 GiB (1073847228 bytes), \
+             past its memory limit of 1.00 GiB (1073741824 bytes)"
         );
         assert_eq!(amount(1023), "1023 bytes");
     }

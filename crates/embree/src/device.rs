@@ -7,16 +7,32 @@ use std::collections::HashMap;
 use std::ffi::{CStr, CString, c_char, c_void};
 use std::fmt;
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::atomic::{AtomicI64, Ordering};
+use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
 use std::sync::{Arc, LazyLock, Mutex, PoisonError, Weak};
 
 /// What Embree reports through callbacks. Boxed inside [`Device`] so its address, handed to
 /// Embree as the callbacks' user pointer, stays fixed for the device's whole life.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 struct DeviceEvents {
     last_error: Mutex<Option<String>>,
     /// Bytes Embree has allocated minus bytes it has freed, as told by the memory monitor.
     allocated_bytes: AtomicI64,
+    /// The most bytes Embree may hold: an allocation past it is refused (`u64::MAX`: none).
+    limit_bytes: AtomicU64,
+    /// The largest total an allocation was refused at since [`Device::set_memory_limit`]
+    /// (0: none refused).
+    refused_at: AtomicU64,
+}
+
+impl Default for DeviceEvents {
+    fn default() -> Self {
+        DeviceEvents {
+            last_error: Mutex::default(),
+            allocated_bytes: AtomicI64::new(0),
+            limit_bytes: AtomicU64::new(u64::MAX),
+            refused_at: AtomicU64::new(0),
+        }
+    }
 }
 
 impl DeviceEvents {
@@ -45,7 +61,10 @@ impl DeviceEvents {
 /// Memory: a memory-monitor callback keeps a running count of the bytes Embree holds
 /// ([`Device::allocated_bytes`]). A scene's memory is the change of that count across its
 /// build, which is only that scene's memory when builds on one device run one at a time — as
-/// they do in the harness.
+/// they do in the harness. The same callback enforces an optional limit on that count
+/// ([`Device::set_memory_limit`]): Embree cancels the operation that would pass it with
+/// `RTC_ERROR_OUT_OF_MEMORY`, frees what it had allocated, and stays usable, so a scene too
+/// large for the machine is an error and not the kernel killing the process.
 pub struct Device {
     raw: sys::RTCDevice,
     config: String,
@@ -120,6 +139,27 @@ impl Device {
     /// Bytes Embree currently holds on this device, per its memory monitor.
     pub fn allocated_bytes(&self) -> i64 {
         self.events.allocated_bytes.load(Ordering::Relaxed)
+    }
+
+    /// Sets the most bytes Embree may hold on this device (`None`: no limit) and forgets any
+    /// earlier refusal. The limit is the device's, not a scene's: it counts every scene alive
+    /// on the device, so it is meant to be set before a build when builds run one at a time.
+    pub fn set_memory_limit(&self, limit_bytes: Option<u64>) {
+        self.events
+            .limit_bytes
+            .store(limit_bytes.unwrap_or(u64::MAX), Ordering::Relaxed);
+        self.events.refused_at.store(0, Ordering::Relaxed);
+    }
+
+    /// The total Embree would have held with the largest allocation the limit refused since
+    /// [`Device::set_memory_limit`], if one was refused.
+    pub fn refused_at(&self) -> Option<u64> {
+        Some(self.events.refused_at.load(Ordering::Relaxed)).filter(|&b| b > 0)
+    }
+
+    /// The limit [`Device::set_memory_limit`] set, if any.
+    pub fn memory_limit(&self) -> Option<u64> {
+        Some(self.events.limit_bytes.load(Ordering::Relaxed)).filter(|&b| b != u64::MAX)
     }
 
     /// The last message Embree passed to the error callback, if not yet consumed by a check.
@@ -215,16 +255,25 @@ unsafe extern "C" fn on_error(user: *mut c_void, _code: sys::RTCError, message: 
     }));
 }
 
-/// Memory-monitor callback: may run on several threads at once, hence the atomic. Always
-/// returns true (never cancels), so every reported byte count really happened and is added.
-/// The body is an atomic add and cannot panic.
-unsafe extern "C" fn on_memory(user: *mut c_void, bytes: isize, _post: bool) -> bool {
+/// Memory-monitor callback: may run on several threads at once, hence the atomics. An
+/// allocation that takes the count past the limit is refused (false): Embree then cancels the
+/// operation. Per rtcSetDeviceMemoryMonitorFunction(3), a refused allocation reported before
+/// it happens (`post == false`) never happens, so it is taken back out of the count; one
+/// reported after it happened stays counted, as Embree frees it later. Frees cannot be
+/// refused. The body is atomic arithmetic and cannot panic.
+unsafe extern "C" fn on_memory(user: *mut c_void, bytes: isize, post: bool) -> bool {
     // SAFETY: as in `on_error`.
     let events = unsafe { &*(user as *const DeviceEvents) };
-    events
-        .allocated_bytes
-        .fetch_add(bytes as i64, Ordering::Relaxed);
-    true
+    let bytes = bytes as i64;
+    let total = events.allocated_bytes.fetch_add(bytes, Ordering::Relaxed) + bytes;
+    if bytes <= 0 || total.max(0) as u64 <= events.limit_bytes.load(Ordering::Relaxed) {
+        return true;
+    }
+    if !post {
+        events.allocated_bytes.fetch_sub(bytes, Ordering::Relaxed);
+    }
+    events.refused_at.fetch_max(total as u64, Ordering::Relaxed);
+    false
 }
 
 #[cfg(test)]

@@ -17,11 +17,27 @@ pub enum EmbreeError {
         code: &'static str,
         message: String,
     },
+    /// The device's memory limit refused an allocation of the build: `reached_bytes` is what
+    /// Embree would have held with it (a lower bound on what the build needs).
+    #[error("Embree was refused memory at {reached_bytes} bytes, past its limit of {limit_bytes}")]
+    MemoryLimit {
+        reached_bytes: u64,
+        limit_bytes: u64,
+    },
 }
 
 impl From<EmbreeError> for BuildError {
     fn from(e: EmbreeError) -> BuildError {
-        BuildError::Backend(e.to_string())
+        match e {
+            EmbreeError::MemoryLimit {
+                reached_bytes,
+                limit_bytes,
+            } => BuildError::MemoryLimitReached {
+                reached_bytes,
+                limit_bytes,
+            },
+            e => BuildError::Backend(e.to_string()),
+        }
     }
 }
 

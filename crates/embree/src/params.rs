@@ -68,6 +68,12 @@ pub struct EmbreeParams {
     /// reports only when set.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub coherent_occluded16: bool,
+    /// The most bytes Embree may hold on the device while building (the device's memory
+    /// monitor refuses the allocation past it, and the build fails with
+    /// [`raybench_accel::BuildError::MemoryLimitReached`]); `None`: no limit. Written
+    /// into reports only when set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory_limit_bytes: Option<u64>,
 }
 
 impl EmbreeParams {

@@ -82,10 +82,42 @@ impl EmbreeScene {
         mesh: Arc<TriangleMesh>,
         params: &EmbreeParams,
     ) -> Result<EmbreeScene, EmbreeError> {
-        let scene = new_scene(&device, params)?;
+        device.set_memory_limit(params.memory_limit_bytes);
+        let built = Self::commit(&device, &mesh, params);
+        let refused = device.refused_at();
+        device.set_memory_limit(None);
+        let (scene, commit_time, buffer_bytes, commit_bytes) = match (built, refused) {
+            (Err(_), Some(reached_bytes)) => {
+                return Err(EmbreeError::MemoryLimit {
+                    reached_bytes,
+                    limit_bytes: params.memory_limit_bytes.unwrap_or(u64::MAX),
+                });
+            }
+            (built, _) => built?,
+        };
+        Ok(EmbreeScene {
+            scene,
+            name: params.name(),
+            params: params.clone(),
+            commit_time,
+            commit_bytes,
+            buffer_bytes,
+            device,
+            mesh,
+        })
+    }
+
+    /// The scene with `mesh` attached and committed; its commit time, and the bytes its
+    /// buffers and its commit took on the device.
+    fn commit(
+        device: &Device,
+        mesh: &TriangleMesh,
+        params: &EmbreeParams,
+    ) -> Result<(OwnedScene, Duration, i64, i64), EmbreeError> {
+        let scene = new_scene(device, params)?;
         let before_buffers = device.allocated_bytes();
         if !mesh.is_empty() {
-            attach_triangles(&device, &scene, &mesh)?;
+            attach_triangles(device, &scene, mesh)?;
         }
         let before_commit = device.allocated_bytes();
         let start = Instant::now();
@@ -94,16 +126,12 @@ impl EmbreeScene {
         let commit_time = start.elapsed();
         device.check("rtcCommitScene")?;
         let after_commit = device.allocated_bytes();
-        Ok(EmbreeScene {
+        Ok((
             scene,
-            name: params.name(),
-            params: params.clone(),
             commit_time,
-            commit_bytes: after_commit - before_commit,
-            buffer_bytes: before_commit - before_buffers,
-            device,
-            mesh,
-        })
+            before_commit - before_buffers,
+            after_commit - before_commit,
+        ))
     }
 
     /// Closest hit, or why the ray may not be traced.

@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::random_triangles;
+use common::{random_triangles, workload};
 use raybench_accel::Accel;
 use raybench_embree::{
     Device, EmbreeError, EmbreeInfo, EmbreeParams, EmbreeScene, ISA_FROM_CONFIG, ISA_INFERRED,
@@ -125,4 +125,75 @@ fn memory_monitor_accounts_for_each_build() {
         after <= baseline + (l as i64) / 10,
         "freed memory is counted back"
     );
+}
+
+/// A memory limit makes the build that would pass it fail with `MemoryLimit`
+/// (`MemoryLimitReached` for the harness) wherever in the build the refused allocation falls, as Embree's own
+/// memory-monitor regression tests cancel at random points: limits from 16 KiB up to what the
+/// scene takes, on one and two threads. Every refused build gives back what it had taken, the
+/// limit is lifted afterwards, and the device then builds the same scene with the same
+/// answers.
+#[test]
+fn a_memory_limit_refuses_the_build_wherever_it_binds_and_the_device_recovers() {
+    let mesh = random_triangles(0x5EED_0008, 20_000);
+    let rays = workload(&mesh, 0x5EED_0009, 2_000);
+    for threads in [1, 2] {
+        let config = format!("threads={threads},start_threads=1,set_affinity=0");
+        let device = Arc::new(Device::new(&config).unwrap());
+        let free =
+            EmbreeScene::build_on(device.clone(), mesh.clone(), &EmbreeParams::medium()).unwrap();
+        let needs = free.memory().nodes + free.build_stats().extra["buffer_bytes"] as u64;
+        let expected: Vec<_> = rays.iter().map(|r| free.intersect(r)).collect();
+        drop(free);
+        let baseline = device.allocated_bytes();
+        let (mut refused, mut built) = (0, 0);
+        let mut limit = 16u64 << 10;
+        while limit < 4 * needs {
+            let params = EmbreeParams {
+                memory_limit_bytes: Some(limit),
+                ..EmbreeParams::medium()
+            };
+            match EmbreeScene::build_on(device.clone(), mesh.clone(), &params) {
+                Err(
+                    e @ EmbreeError::MemoryLimit {
+                        reached_bytes,
+                        limit_bytes,
+                    },
+                ) => {
+                    assert_eq!(limit_bytes, limit);
+                    assert!(reached_bytes > limit, "{reached_bytes} at limit {limit}");
+                    assert!(
+                        matches!(
+                            raybench_accel::BuildError::from(e),
+                            raybench_accel::BuildError::MemoryLimitReached { .. }
+                        ),
+                        "limit {limit}"
+                    );
+                    refused += 1;
+                }
+                Err(e) => panic!("{threads} threads, limit {limit}: {e}"),
+                Ok(scene) => {
+                    let got: Vec<_> = rays.iter().map(|r| scene.intersect(r)).collect();
+                    assert_eq!(got, expected, "{threads} threads, limit {limit}");
+                    built += 1;
+                }
+            }
+            assert_eq!(
+                device.memory_limit(),
+                None,
+                "the limit is lifted after a build"
+            );
+            assert_eq!(
+                device.allocated_bytes(),
+                baseline,
+                "{threads} threads, limit {limit}: what the build took is given back"
+            );
+            limit = limit * 3 / 2;
+        }
+        println!("{threads} threads: needs {needs} B; {refused} limits refused, {built} built");
+        assert!(
+            refused >= 10 && built >= 2,
+            "{refused} refused, {built} built"
+        );
+    }
 }

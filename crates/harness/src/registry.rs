@@ -27,8 +27,9 @@ pub struct BuildContext {
     /// Worker threads of this run (Embree's device gets `threads=N`; our builders use the
     /// rayon pool they run in).
     pub threads: usize,
-    /// The most memory one of our builds may plan on: each estimates what it needs before
-    /// allocating and refuses with "scene too large" past this (its `memory_limit_bytes`).
+    /// The most memory one build may take: each of our builders estimates what it needs
+    /// before allocating and refuses with "scene too large" past this (its
+    /// `memory_limit_bytes`); Embree's device refuses the allocation that would pass it.
     pub memory_limit_bytes: u64,
 }
 
@@ -126,9 +127,13 @@ pub(crate) fn register<A: Accel + 'static>(
     }
 }
 
+/// An Embree entry: Embree's own threads set to the run's, and the run's memory limit enforced
+/// through the device's memory monitor, so Embree refuses a scene our builders would refuse
+/// as too large instead of running the machine out of memory.
 fn embree(base: EmbreeParams) -> impl Fn(&BuildContext) -> EmbreeParams + Send + Sync {
     move |ctx| EmbreeParams {
         threads: ctx.threads,
+        memory_limit_bytes: Some(ctx.memory_limit_bytes),
         ..base.clone()
     }
 }

@@ -6,7 +6,8 @@
 //! 8 GiB, which a CI runner or a laptop may not hold. So the built-in structures take the least
 //! of their own limit and half of this machine's memory (its cgroup's limit where lower): the
 //! rule the CLI's `--rays` and `--points` bounds follow, leaving the other half for the scene,
-//! the rays and the scene's other structures, all alive at once in a run.
+//! the rays and the scene's other structures, all alive at once in a run. Embree's entries take
+//! the same limit through their device's memory monitor (`registry.rs`, `embree`).
 
 use super::BuildContext;
 use raybench_bvh::{BvhParams, WideParams};
