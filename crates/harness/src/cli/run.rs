@@ -86,7 +86,10 @@ pub fn run(registry: &Registry, args: RunArgs) -> Result<ExitCode> {
     let opts = RunOptions {
         suite: sel.suite.clone(),
         structures: r.structures,
-        suite_limits: sel.suite.is_some() && sel.structures.is_empty(),
+        // Structures the user did not name (a suite's list, or every structure) keep their
+        // suite limits: brute force over a million triangles, which nobody asked for by name,
+        // would take hours.
+        suite_limits: sel.structures.is_empty(),
         workloads: r.workloads,
         rays: r.rays,
         points: r.points,

@@ -34,7 +34,8 @@ pub struct RunOptions {
     pub suite: Option<String>,
     pub structures: Vec<String>,
     /// Skip a structure on scenes above its suite triangle limit (brute force): when the
-    /// structures come from a suite's list, not when the user named them.
+    /// structures come from a suite's list or the default of every structure, not when the
+    /// user named them.
     pub suite_limits: bool,
     pub workloads: Vec<Workload>,
     pub rays: usize,

@@ -223,6 +223,66 @@ fn a_suite_skips_brute_force_past_its_limit_and_says_so() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// Without `--suite` or `--structures`, every structure runs, and brute force keeps its limit
+/// there too: a user who names only a large scene has not asked for hours of brute force.
+#[test]
+fn every_structure_by_default_skips_brute_force_past_its_limit() {
+    let dir = scratch("default-limit");
+    let out = dir.join("out");
+    let status = raybench()
+        .args([
+            "run",
+            "--scenes",
+            "sphere:triangles=30000,teapot:triangles=500",
+            "--workloads",
+            "primary",
+            "--rays",
+            "200",
+            "--build-runs",
+            "1",
+            "--trace-runs",
+            "1",
+            "--no-images",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let report = raybench_harness::report::run::Report::read(&out.join("report.json")).unwrap();
+    assert!(report.run.suite_limits);
+    for brute in ["bruteforce", "bruteforce-watertight"] {
+        let scenes: Vec<&str> = report
+            .results
+            .iter()
+            .filter(|e| e.structure == brute)
+            .map(|e| e.scene.as_str())
+            .collect();
+        assert_eq!(scenes, ["teapot:triangles=500"], "{brute}");
+        assert!(
+            report
+                .notes
+                .iter()
+                .any(|n| n.contains(&format!("{brute} skipped on sphere:triangles=30000"))),
+            "{:?}",
+            report.notes
+        );
+    }
+    assert!(
+        report
+            .results
+            .iter()
+            .any(|e| e.structure == "kd-sah" && e.scene == "sphere:triangles=30000"),
+        "every other structure runs on the large scene"
+    );
+    assert_eq!(report.mismatches(), 0);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn bad_numbers_name_the_value_and_exit_1() {
     let cases: [(&[&str], &str); 8] = [
