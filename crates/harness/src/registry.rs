@@ -128,8 +128,9 @@ pub(crate) fn register<A: Accel + 'static>(
 }
 
 /// An Embree entry: Embree's own threads set to the run's, and the run's memory limit enforced
-/// through the device's memory monitor, so Embree refuses a scene our builders would refuse
-/// as too large instead of running the machine out of memory.
+/// through the device's memory monitor (which counts every Embree scene alive on the device),
+/// so a scene too large for the machine is an error in the report, not the kernel killing the
+/// run.
 fn embree(base: EmbreeParams) -> impl Fn(&BuildContext) -> EmbreeParams + Send + Sync {
     move |ctx| EmbreeParams {
         threads: ctx.threads,
