@@ -22,4 +22,5 @@ mod results;
 mod rounds;
 mod run;
 mod scene_cmd;
+mod suite_limits;
 mod verify;

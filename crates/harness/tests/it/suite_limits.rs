@@ -1,0 +1,126 @@
+//! Brute force's triangle limit in `run`: structures the user did not name (a suite's list, or
+//! every structure) skip it above 20,000 triangles with a note; named, it runs everywhere.
+
+use crate::common::{raybench, scratch};
+
+/// A suite runs brute force only on scenes within its limit (20,000 triangles), with a note
+/// naming the scene and the limit; naming it with `--structures` runs it everywhere.
+#[test]
+fn a_suite_skips_brute_force_past_its_limit_and_says_so() {
+    let dir = scratch("suite-limit");
+    std::fs::write(
+        dir.join("limits.json"),
+        r#"{"name": "limits", "description": "brute force past its suite limit",
+            "scenes": ["sphere:triangles=30000", "teapot:triangles=500"],
+            "structures": ["bruteforce", "bvh8-binned"], "workloads": ["primary"], "rays": 200}"#,
+    )
+    .unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        let out_dir = dir.join(out);
+        let status = raybench()
+            .env("RAYBENCH_SUITES", &dir)
+            .args(["run", "--suite", "limits", "--no-images", "--out"])
+            .arg(&out_dir)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            status.status.success(),
+            "{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+        raybench_harness::report::run::Report::read(&out_dir.join("report.json")).unwrap()
+    };
+    let brute_scenes = |r: &raybench_harness::report::run::Report| -> Vec<String> {
+        let mut s: Vec<String> = r
+            .results
+            .iter()
+            .filter(|e| e.structure == "bruteforce")
+            .map(|e| e.scene.clone())
+            .collect();
+        s.sort();
+        s
+    };
+    let limited = run("limited", &[]);
+    assert_eq!(brute_scenes(&limited), ["teapot:triangles=500"]);
+    assert!(
+        limited.notes.iter().any(
+            |n| n.contains("bruteforce skipped on sphere:triangles=30000")
+                && n.contains("suite limit 20000")
+        ),
+        "{:?}",
+        limited.notes
+    );
+    assert_eq!(limited.mismatches(), 0);
+    let named = run("named", &["--structures", "bruteforce,bvh8-binned"]);
+    assert_eq!(
+        brute_scenes(&named),
+        ["sphere:triangles=30000", "teapot:triangles=500"]
+    );
+    assert!(
+        !named.notes.iter().any(|n| n.contains("skipped")),
+        "{:?}",
+        named.notes
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Without `--suite` or `--structures`, every structure runs, and brute force keeps its limit
+/// there too: a user who names only a large scene has not asked for hours of brute force.
+#[test]
+fn every_structure_by_default_skips_brute_force_past_its_limit() {
+    let dir = scratch("default-limit");
+    let out = dir.join("out");
+    let status = raybench()
+        .args([
+            "run",
+            "--scenes",
+            "sphere:triangles=30000,teapot:triangles=500",
+            "--workloads",
+            "primary",
+            "--rays",
+            "200",
+            "--build-runs",
+            "1",
+            "--trace-runs",
+            "1",
+            "--no-images",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let report = raybench_harness::report::run::Report::read(&out.join("report.json")).unwrap();
+    assert!(report.run.suite_limits);
+    for brute in ["bruteforce", "bruteforce-watertight"] {
+        let scenes: Vec<&str> = report
+            .results
+            .iter()
+            .filter(|e| e.structure == brute)
+            .map(|e| e.scene.as_str())
+            .collect();
+        assert_eq!(scenes, ["teapot:triangles=500"], "{brute}");
+        assert!(
+            report
+                .notes
+                .iter()
+                .any(|n| n.contains(&format!("{brute} skipped on sphere:triangles=30000"))),
+            "{:?}",
+            report.notes
+        );
+    }
+    assert!(
+        report
+            .results
+            .iter()
+            .any(|e| e.structure == "kd-sah" && e.scene == "sphere:triangles=30000"),
+        "every other structure runs on the large scene"
+    );
+    assert_eq!(report.mismatches(), 0);
+    std::fs::remove_dir_all(dir).unwrap();
+}
