@@ -128,9 +128,9 @@ fn memory_monitor_accounts_for_each_build() {
 }
 
 /// A memory limit makes the build that would pass it fail with `MemoryLimit`
-/// (`MemoryLimitReached` for the harness) wherever in the build the refused allocation falls, as Embree's own
-/// memory-monitor regression tests cancel at random points: limits from 16 KiB up to what the
-/// scene takes, on one and two threads. Every refused build gives back what it had taken, the
+/// (`MemoryLimitReached` for the harness) wherever in the build the refused allocation falls,
+/// as Embree's own memory-monitor regression tests cancel at random points: limits from 16 KiB
+/// up to 4× what the scene takes, on one and two threads. Every refused build gives back what it had taken, the
 /// limit is lifted afterwards, and the device then builds the same scene with the same
 /// answers.
 #[test]

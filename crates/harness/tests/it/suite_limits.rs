@@ -2,6 +2,20 @@
 //! every structure) skip it above 20,000 triangles with a note; named, it runs everywhere.
 
 use crate::common::{raybench, scratch};
+use raybench_harness::report::run::Report;
+use std::path::Path;
+use std::process::Command;
+
+/// Runs `run`, which must succeed, and reads the report it wrote into `out`.
+fn report_of(mut run: Command, out: &Path) -> Report {
+    let status = run.arg("--out").arg(out).output().unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    Report::read(&out.join("report.json")).unwrap()
+}
 
 /// A suite runs brute force only on scenes within its limit (20,000 triangles), with a note
 /// naming the scene and the limit; naming it with `--structures` runs it everywhere.
@@ -16,22 +30,13 @@ fn a_suite_skips_brute_force_past_its_limit_and_says_so() {
     )
     .unwrap();
     let run = |out: &str, extra: &[&str]| {
-        let out_dir = dir.join(out);
-        let status = raybench()
-            .env("RAYBENCH_SUITES", &dir)
-            .args(["run", "--suite", "limits", "--no-images", "--out"])
-            .arg(&out_dir)
-            .args(extra)
-            .output()
-            .unwrap();
-        assert!(
-            status.status.success(),
-            "{}",
-            String::from_utf8_lossy(&status.stderr)
-        );
-        raybench_harness::report::run::Report::read(&out_dir.join("report.json")).unwrap()
+        let mut run = raybench();
+        run.env("RAYBENCH_SUITES", &dir)
+            .args(["run", "--suite", "limits", "--no-images"])
+            .args(extra);
+        report_of(run, &dir.join(out))
     };
-    let brute_scenes = |r: &raybench_harness::report::run::Report| -> Vec<String> {
+    let brute_scenes = |r: &Report| -> Vec<String> {
         let mut s: Vec<String> = r
             .results
             .iter()
@@ -70,32 +75,22 @@ fn a_suite_skips_brute_force_past_its_limit_and_says_so() {
 #[test]
 fn every_structure_by_default_skips_brute_force_past_its_limit() {
     let dir = scratch("default-limit");
-    let out = dir.join("out");
-    let status = raybench()
-        .args([
-            "run",
-            "--scenes",
-            "sphere:triangles=30000,teapot:triangles=500",
-            "--workloads",
-            "primary",
-            "--rays",
-            "200",
-            "--build-runs",
-            "1",
-            "--trace-runs",
-            "1",
-            "--no-images",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        status.status.success(),
-        "{}",
-        String::from_utf8_lossy(&status.stderr)
-    );
-    let report = raybench_harness::report::run::Report::read(&out.join("report.json")).unwrap();
+    let mut run = raybench();
+    run.args([
+        "run",
+        "--scenes",
+        "sphere:triangles=30000,teapot:triangles=500",
+        "--workloads",
+        "primary",
+        "--rays",
+        "200",
+        "--build-runs",
+        "1",
+        "--trace-runs",
+        "1",
+        "--no-images",
+    ]);
+    let report = report_of(run, &dir.join("out"));
     assert!(report.run.suite_limits);
     for brute in ["bruteforce", "bruteforce-watertight"] {
         let scenes: Vec<&str> = report
