@@ -130,9 +130,9 @@ fn memory_monitor_accounts_for_each_build() {
 /// A memory limit makes the build that would pass it fail with `MemoryLimit`
 /// (`MemoryLimitReached` for the harness) wherever in the build the refused allocation falls,
 /// as Embree's own memory-monitor regression tests cancel at random points: limits from 16 KiB
-/// up to 4× what the scene takes, on one and two threads. Every refused build gives back what it had taken, the
-/// limit is lifted afterwards, and the device then builds the same scene with the same
-/// answers.
+/// up to 4× what the scene takes, on one and two threads. Every refused build gives back what
+/// it had taken, the limit is lifted afterwards, and the builds that fit give the same answers
+/// as a build without a limit.
 #[test]
 fn a_memory_limit_refuses_the_build_wherever_it_binds_and_the_device_recovers() {
     let mesh = random_triangles(0x5EED_0008, 20_000);
