@@ -1,9 +1,11 @@
 //! The two-level grid: the shared conformance suite with `validate()` after every build, knobs
 //! at their extremes, the teapot in a stadium at size ratios where the uniform grid collapses,
 //! rays along cell planes at both levels, the same structure on any thread count, copies of
-//! one triangle kept in lists, and memory errors instead of aborts.
+//! one triangle kept in lists, piles through one point capped, and memory errors instead of
+//! aborts.
 
 use raybench_accel::{Accel, Counters};
+use raybench_geom::{Ray, Vec3};
 use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
 use raybench_testkit::points::point_conformance;
 use raybench_testkit::{
@@ -219,4 +221,65 @@ fn copies_of_one_triangle_get_no_cell_grids() {
 fn point_queries_conform() {
     let counts = point_conformance::<Grid2>(&Grid2Params::default(), &|g, m| g.validate(m));
     assert_eq!(counts.mismatch, 0);
+}
+
+/// Triangles that all cross one point fill nearly every cell of a crowded cell's grid, and the
+/// cost model, pricing the mean cell against a list of thousands, would accept such grids at
+/// hundreds of references per triangle (minutes of build time at 10,000 triangles). The cap on
+/// references per triangle leaves those cells their lists, the answers stay right (rays aimed
+/// at the shared point hit every triangle there), and on scenes of every other kind, including
+/// the adversarial fan, it changes nothing.
+#[test]
+fn a_pile_through_one_point_is_capped_in_references_per_triangle() {
+    let uncapped = Grid2Params {
+        max_refs_per_triangle: u32::MAX,
+        ..Grid2Params::default()
+    };
+    let mesh = generated("one-centroid:triangles=2000", SEED);
+    let capped = Grid2::build(mesh.clone(), &Grid2Params::default()).unwrap();
+    let free = Grid2::build(mesh.clone(), &uncapped).unwrap();
+    assert_eq!(capped.validate(&mesh), Ok(()));
+    assert_eq!(free.validate(&mesh), Ok(()));
+    let (c, f) = (capped.build_stats(), free.build_stats());
+    assert!(
+        c.refs * 2 < f.refs && capped.cell_grids() < free.cell_grids(),
+        "capped {c:?}\nuncapped {f:?}"
+    );
+    // From a sphere around the pile, through the shared point (the origin).
+    let mut rays = random_rays_in(&mesh.bounds().enlarged(0.5), 300, SEED);
+    rays.extend(
+        random_rays_in(&mesh.bounds(), 300, SEED + 1)
+            .iter()
+            .map(|r| {
+                let from = r.origin().normalize_or(Vec3::X) * 3.0;
+                Ray::infinite(from, -from)
+            }),
+    );
+    let case = Case {
+        name: "one-centroid".into(),
+        seed: SEED,
+        mesh: mesh.clone(),
+        rays,
+    };
+    let counts =
+        check_case::<Grid2>(&case, &Grid2Params::default(), &|g, m| g.validate(m)).unwrap();
+    assert_eq!(counts.mismatch, 0, "{counts:?}");
+    assert!(counts.tie > 0, "rays through the shared point: {counts:?}");
+    for spec in [
+        "teapot-in-stadium:stadium_triangles=20000,teapot_triangles=4000",
+        "fan",
+        "hair",
+        "sphere:triangles=30000",
+    ] {
+        let mesh = generated(spec, SEED);
+        let capped = Grid2::build(mesh.clone(), &Grid2Params::default()).unwrap();
+        let free = Grid2::build(mesh.clone(), &uncapped).unwrap();
+        assert!(capped.cell_grids() > 0, "{spec}");
+        assert_eq!(capped.build_stats(), free.build_stats(), "{spec}");
+    }
+    let zero = Grid2Params {
+        max_refs_per_triangle: 0,
+        ..Grid2Params::default()
+    };
+    assert!(Grid2::build(mesh, &zero).is_err());
 }

@@ -5,7 +5,8 @@
 //! and noisy). Used to choose the defaults documented on `Grid2Params`.
 //!
 //! `cargo run --release -p raybench-harness --example grid2tune -- SCENE[,SCENE...] [top=1]
-//!  [cell=2] [levels=3] [crowded=8] [maxres=128] [enter=8] [step=4] [rays=100000] [reps=3]`
+//!  [cell=2] [levels=3] [crowded=8] [maxres=128] [enter=8] [step=4] [refs=64] [rays=100000]
+//!  [reps=3]`
 
 use raybench_accel::Accel;
 use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
@@ -37,6 +38,7 @@ fn main() {
             "maxres" => p.max_cell_resolution = v.parse().unwrap(),
             "enter" => p.entry_cost = v.parse().unwrap(),
             "step" => p.cell_cost = v.parse().unwrap(),
+            "refs" => p.max_refs_per_triangle = v.parse().unwrap(),
             "rays" => rays_n = v.parse().unwrap(),
             "reps" => reps = v.parse().unwrap(),
             _ => panic!("unknown knob {k}"),

@@ -123,8 +123,9 @@ impl Inserted {
 /// `list`, inserted, or `None` when it keeps its list: the cell must be crowded
 /// ([`may_subdivide`]), its grid more than one cell ([`cell_layout`]; `cell` is the cell's
 /// enlarged box, `m` the insertion margin), [`worth_it`] (first with one reference per
-/// triangle, before paying for the insertion) and able to tell the list's triangles apart
-/// ([`separates`]). Build and `validate()` both decide with it.
+/// triangle, before paying for the insertion), able to tell the list's triangles apart
+/// ([`separates`]) and within [`Grid2Params::max_refs_per_triangle`]. Build and `validate()`
+/// both decide with it.
 pub(super) fn own_grid(
     mesh: &TriangleMesh,
     list: &[u32],
@@ -141,7 +142,8 @@ pub(super) fn own_grid(
         return None;
     }
     // Checked after every triangle, so a grid that comes back passed with all its references.
-    let keep = |refs: usize| worth_it(refs, list.len(), &layout, params);
+    let most = list.len() as u64 * params.max_refs_per_triangle as u64;
+    let keep = |refs: usize| refs as u64 <= most && worth_it(refs, list.len(), &layout, params);
     let (offsets, refs) = insert(mesh, list, &layout, keep)?;
     Some(Inserted {
         layout,

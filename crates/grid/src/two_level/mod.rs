@@ -56,6 +56,9 @@ pub struct Grid2Params {
     /// The cost of stepping one cell (a cache line or two of offsets and occupancy, the DDA's
     /// comparisons), in triangle tests.
     pub cell_cost: f64,
+    /// The most references per triangle of its list a cell's grid may make: a grid making more
+    /// is refused and the cell keeps its list. See [`Grid2Params::MAX_REFS_PER_TRIANGLE`].
+    pub max_refs_per_triangle: u32,
 
     /// The build refuses with [`BuildError::TooLarge`] past this estimate of its memory.
     pub memory_limit_bytes: u64,
@@ -73,6 +76,14 @@ impl Grid2Params {
     pub const CROWDED: u32 = 8;
     pub const ENTRY_COST: f64 = 8.0;
     pub const CELL_COST: f64 = 4.0;
+    /// Why a cap besides the cost model: triangles that all cross one point fill about
+    /// `(cell_density · k)^(2/3)` cells each of a grid for `k` of them, and the cost model,
+    /// pricing the mean cell against a list of `k`, still accepts such grids, so references and
+    /// build time grow as `k^(5/3)` per crowded cell (10,000 triangles through one point: 2,300
+    /// references per triangle, a 52 s build). Accepted grids of the shared and generated
+    /// scenes make at most 19 per triangle (conference), 28 on the adversarial `fan`, so 64
+    /// binds only on such piles, and it bounds every cell's insertion.
+    pub const MAX_REFS_PER_TRIANGLE: u32 = 64;
     /// The most levels a build accepts (the walk recurses once per level).
     pub const LEVEL_LIMIT: u32 = 8;
 
@@ -123,6 +134,7 @@ impl Default for Grid2Params {
             crowded: Grid2Params::CROWDED,
             entry_cost: Grid2Params::ENTRY_COST,
             cell_cost: Grid2Params::CELL_COST,
+            max_refs_per_triangle: Grid2Params::MAX_REFS_PER_TRIANGLE,
 
             memory_limit_bytes: GridParams::MEMORY_LIMIT,
             parallel_chunk: 8192,
@@ -199,12 +211,13 @@ impl Accel for Grid2 {
             || !cost(params.cell_cost)
             || params.max_resolution < 1
             || params.max_cell_resolution < 1
+            || params.max_refs_per_triangle < 1
             || !(1..=Grid2Params::LEVEL_LIMIT).contains(&params.max_levels)
             || params.parallel_chunk < 1
         {
             return Err(BuildError::Unsupported(format!(
-                "densities > 0, costs >= 0, resolutions >= 1, max_levels in 1..={}, parallel_chunk >= 1 \
-                 (got {params:?})",
+                "densities > 0, costs >= 0, resolutions >= 1, max_refs_per_triangle >= 1, \
+                 max_levels in 1..={}, parallel_chunk >= 1 (got {params:?})",
                 Grid2Params::LEVEL_LIMIT
             )));
         }
