@@ -225,7 +225,7 @@ fn point_queries_conform() {
 
 /// Triangles that all cross one point fill nearly every cell of a crowded cell's grid, and the
 /// cost model, pricing the mean cell against a list of thousands, would accept such grids at
-/// hundreds of references per triangle (minutes of build time at 10,000 triangles). The cap on
+/// hundreds of references per triangle (a 52 s build at 10,000 triangles). The cap on
 /// references per triangle leaves those cells their lists, the answers stay right (rays aimed
 /// at the shared point hit every triangle there), and on scenes of every other kind, including
 /// the adversarial fan, it changes nothing.
