@@ -81,8 +81,9 @@ impl Grid2Params {
     /// pricing the mean cell against a list of `k`, still accepts such grids, so references and
     /// build time grow as `k^(5/3)` per crowded cell (10,000 triangles through one point: 2,300
     /// references per triangle, a 52 s build). Accepted grids of the shared and generated
-    /// scenes make at most 19 per triangle (conference), 28 on the adversarial `fan`, so 64
-    /// binds only on such piles, and it bounds every cell's insertion.
+    /// scenes make at most 24 per triangle (a 500k-triangle sphere's poles; conference 19), 56
+    /// on the adversarial `fan` at 50k triangles, so 64 binds only on such piles, and it bounds
+    /// every cell's insertion.
     pub const MAX_REFS_PER_TRIANGLE: u32 = 64;
     /// The most levels a build accepts (the walk recurses once per level).
     pub const LEVEL_LIMIT: u32 = 8;
