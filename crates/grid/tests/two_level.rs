@@ -5,11 +5,10 @@
 //! aborts.
 
 use raybench_accel::{Accel, Counters};
-use raybench_geom::{Ray, Vec3};
 use raybench_grid::{Grid, Grid2, Grid2Params, GridParams};
 use raybench_testkit::points::point_conformance;
 use raybench_testkit::{
-    Case, check_case, check_conformance, check_lattice, expect_too_large, generated,
+    Case, centroid_rays, check_case, check_conformance, check_lattice, expect_too_large, generated,
     random_rays_in, refused_rays,
 };
 use std::sync::Arc;
@@ -245,16 +244,9 @@ fn a_pile_through_one_point_is_capped_in_references_per_triangle() {
         c.refs * 2 < f.refs && capped.cell_grids() < free.cell_grids(),
         "capped {c:?}\nuncapped {f:?}"
     );
-    // From a sphere around the pile, through the shared point (the origin).
+    // Every centroid is the shared point, so centroid rays all pass through it.
     let mut rays = random_rays_in(&mesh.bounds().enlarged(0.5), 300, SEED);
-    rays.extend(
-        random_rays_in(&mesh.bounds(), 300, SEED + 1)
-            .iter()
-            .map(|r| {
-                let from = r.origin().normalize_or(Vec3::X) * 3.0;
-                Ray::infinite(from, -from)
-            }),
-    );
+    rays.extend(centroid_rays(&mesh, 300, SEED + 1));
     let case = Case {
         name: "one-centroid".into(),
         seed: SEED,
