@@ -17,10 +17,14 @@ struct DeviceEvents {
     last_error: Mutex<Option<String>>,
     /// Bytes Embree has allocated minus bytes it has freed, as told by the memory monitor.
     allocated_bytes: AtomicI64,
-    /// The most bytes Embree may hold: an allocation past it is refused (`u64::MAX`: none).
+    /// The most bytes Embree may allocate beyond `base_bytes`: an allocation past it is
+    /// refused (`u64::MAX`: none).
     limit_bytes: AtomicU64,
-    /// The largest total an allocation was refused at since [`Device::set_memory_limit`]
-    /// (0: none refused).
+    /// What Embree held when the limit was set: the scenes already on the device, which the
+    /// limit leaves out.
+    base_bytes: AtomicI64,
+    /// The most bytes beyond `base_bytes` an allocation was refused at since
+    /// [`Device::set_memory_limit`] (0: none refused).
     refused_at: AtomicU64,
 }
 
@@ -30,6 +34,7 @@ impl Default for DeviceEvents {
             last_error: Mutex::default(),
             allocated_bytes: AtomicI64::new(0),
             limit_bytes: AtomicU64::new(u64::MAX),
+            base_bytes: AtomicI64::new(0),
             refused_at: AtomicU64::new(0),
         }
     }
@@ -141,18 +146,22 @@ impl Device {
         self.events.allocated_bytes.load(Ordering::Relaxed)
     }
 
-    /// Sets the most bytes Embree may hold on this device (`None`: no limit) and forgets any
-    /// earlier refusal. The limit is the device's, not a scene's: it counts every scene alive
-    /// on the device, so it is meant to be set before a build when builds run one at a time.
+    /// Sets the most bytes Embree may allocate on this device from now on (`None`: no limit)
+    /// and forgets any earlier refusal. What the device holds already (other scenes built on
+    /// it) is left out, so the limit bounds the next build alone, as our builders' limits do;
+    /// it is meant to be set just before a build when builds run one at a time.
     pub fn set_memory_limit(&self, limit_bytes: Option<u64>) {
+        self.events
+            .base_bytes
+            .store(self.allocated_bytes(), Ordering::Relaxed);
         self.events
             .limit_bytes
             .store(limit_bytes.unwrap_or(u64::MAX), Ordering::Relaxed);
         self.events.refused_at.store(0, Ordering::Relaxed);
     }
 
-    /// The total Embree would have held with the largest allocation the limit refused since
-    /// [`Device::set_memory_limit`], if one was refused.
+    /// The bytes allocated since [`Device::set_memory_limit`], with the largest allocation
+    /// the limit refused since then, if one was refused.
     pub fn refused_at(&self) -> Option<u64> {
         Some(self.events.refused_at.load(Ordering::Relaxed)).filter(|&b| b > 0)
     }
@@ -266,13 +275,14 @@ unsafe extern "C" fn on_memory(user: *mut c_void, bytes: isize, post: bool) -> b
     let events = unsafe { &*(user as *const DeviceEvents) };
     let bytes = bytes as i64;
     let total = events.allocated_bytes.fetch_add(bytes, Ordering::Relaxed) + bytes;
-    if bytes <= 0 || total.max(0) as u64 <= events.limit_bytes.load(Ordering::Relaxed) {
+    let added = (total - events.base_bytes.load(Ordering::Relaxed)).max(0) as u64;
+    if bytes <= 0 || added <= events.limit_bytes.load(Ordering::Relaxed) {
         return true;
     }
     if !post {
         events.allocated_bytes.fetch_sub(bytes, Ordering::Relaxed);
     }
-    events.refused_at.fetch_max(total as u64, Ordering::Relaxed);
+    events.refused_at.fetch_max(added, Ordering::Relaxed);
     false
 }
 

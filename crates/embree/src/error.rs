@@ -18,7 +18,7 @@ pub enum EmbreeError {
         message: String,
     },
     /// The device's memory limit refused an allocation of the build: `reached_bytes` is what
-    /// Embree would have held with it (a lower bound on what the build needs).
+    /// the build would have held with it (a lower bound on what the build needs).
     #[error("Embree was refused memory at {reached_bytes} bytes, past its limit of {limit_bytes}")]
     MemoryLimit {
         reached_bytes: u64,

@@ -68,8 +68,8 @@ pub struct EmbreeParams {
     /// reports only when set.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub coherent_occluded16: bool,
-    /// The most bytes Embree may hold on the device while building (the device's memory
-    /// monitor refuses the allocation past it, and the build fails with
+    /// The most bytes Embree may allocate for this build, scenes already on the device left
+    /// out (the device's memory monitor refuses the allocation past it, and the build fails with
     /// [`raybench_accel::BuildError::MemoryLimitReached`]); `None`: no limit. Written
     /// into reports only when set.
     #[serde(default, skip_serializing_if = "Option::is_none")]

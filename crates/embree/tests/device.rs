@@ -197,3 +197,54 @@ fn a_memory_limit_refuses_the_build_wherever_it_binds_and_the_device_recovers() 
         );
     }
 }
+
+/// The limit bounds each build alone, as our builders' limits do: a scene already on the
+/// device (another Embree entry's, in a run) is left out. Beside a scene larger than the limit,
+/// a smaller scene that fits the limit alone still builds, with the answers it has alone, and
+/// one refused is refused at what it would have held itself.
+#[test]
+fn a_memory_limit_leaves_out_the_scenes_already_on_the_device() {
+    let small = random_triangles(0x5EED_000A, 20_000);
+    let large = random_triangles(0x5EED_000B, 200_000);
+    let rays = workload(&small, 0x5EED_000C, 1_000);
+    let device = Arc::new(Device::new("threads=1,start_threads=1,set_affinity=0").unwrap());
+    let held = |scene: &EmbreeScene| {
+        scene.memory().nodes + scene.build_stats().extra["buffer_bytes"] as u64
+    };
+    let alone =
+        EmbreeScene::build_on(device.clone(), small.clone(), &EmbreeParams::medium()).unwrap();
+    let small_needs = held(&alone);
+    let expected: Vec<_> = rays.iter().map(|r| alone.intersect(r)).collect();
+    drop(alone);
+    let resident =
+        EmbreeScene::build_on(device.clone(), large.clone(), &EmbreeParams::medium()).unwrap();
+    let limit = 3 * small_needs;
+    assert!(
+        held(&resident) > limit,
+        "the resident scene ({} B) must be past the limit ({limit} B) for the test to bind",
+        held(&resident)
+    );
+    let with = |limit: u64| EmbreeParams {
+        memory_limit_bytes: Some(limit),
+        ..EmbreeParams::medium()
+    };
+    let beside = EmbreeScene::build_on(device.clone(), small.clone(), &with(limit)).unwrap();
+    let got: Vec<_> = rays.iter().map(|r| beside.intersect(r)).collect();
+    assert_eq!(got, expected);
+    drop(beside);
+    match EmbreeScene::build_on(device.clone(), small.clone(), &with(small_needs / 4)) {
+        Err(EmbreeError::MemoryLimit {
+            reached_bytes,
+            limit_bytes,
+        }) => {
+            assert_eq!(limit_bytes, small_needs / 4);
+            assert!(
+                reached_bytes > limit_bytes && reached_bytes < held(&resident),
+                "refused at {reached_bytes} B: the build's own bytes, not the device's"
+            );
+        }
+        Err(e) => panic!("a quarter of what the scene needs: {e}"),
+        Ok(_) => panic!("built within a quarter of what the scene needs"),
+    }
+    drop(resident);
+}
