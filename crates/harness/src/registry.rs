@@ -128,9 +128,9 @@ pub(crate) fn register<A: Accel + 'static>(
 }
 
 /// An Embree entry: Embree's own threads set to the run's, and the run's memory limit enforced
-/// through the device's memory monitor (which counts every Embree scene alive on the device),
-/// so a scene too large for the machine is an error in the report, not the kernel killing the
-/// run.
+/// through the device's memory monitor (which counts what the build allocates, other Embree
+/// entries' scenes on the device left out, as our builders' limits count their own build), so a
+/// scene too large for the machine is an error in the report, not the kernel killing the run.
 fn embree(base: EmbreeParams) -> impl Fn(&BuildContext) -> EmbreeParams + Send + Sync {
     move |ctx| EmbreeParams {
         threads: ctx.threads,
