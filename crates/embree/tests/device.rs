@@ -127,6 +127,11 @@ fn memory_monitor_accounts_for_each_build() {
     );
 }
 
+/// What a built scene holds on its device: its nodes and its vertex and index buffers.
+fn held_bytes(scene: &EmbreeScene) -> u64 {
+    scene.memory().nodes + scene.build_stats().extra["buffer_bytes"] as u64
+}
+
 /// A memory limit makes the build that would pass it fail with `MemoryLimit`
 /// (`MemoryLimitReached` for the harness) wherever in the build the refused allocation falls,
 /// as Embree's own memory-monitor regression tests cancel at random points: limits from 16 KiB
@@ -142,7 +147,7 @@ fn a_memory_limit_refuses_the_build_wherever_it_binds_and_the_device_recovers() 
         let device = Arc::new(Device::new(&config).unwrap());
         let free =
             EmbreeScene::build_on(device.clone(), mesh.clone(), &EmbreeParams::medium()).unwrap();
-        let needs = free.memory().nodes + free.build_stats().extra["buffer_bytes"] as u64;
+        let needs = held_bytes(&free);
         let expected: Vec<_> = rays.iter().map(|r| free.intersect(r)).collect();
         drop(free);
         let baseline = device.allocated_bytes();
@@ -208,21 +213,18 @@ fn a_memory_limit_leaves_out_the_scenes_already_on_the_device() {
     let large = random_triangles(0x5EED_000B, 200_000);
     let rays = workload(&small, 0x5EED_000C, 1_000);
     let device = Arc::new(Device::new("threads=1,start_threads=1,set_affinity=0").unwrap());
-    let held = |scene: &EmbreeScene| {
-        scene.memory().nodes + scene.build_stats().extra["buffer_bytes"] as u64
-    };
     let alone =
         EmbreeScene::build_on(device.clone(), small.clone(), &EmbreeParams::medium()).unwrap();
-    let small_needs = held(&alone);
+    let small_needs = held_bytes(&alone);
     let expected: Vec<_> = rays.iter().map(|r| alone.intersect(r)).collect();
     drop(alone);
     let resident =
         EmbreeScene::build_on(device.clone(), large.clone(), &EmbreeParams::medium()).unwrap();
     let limit = 3 * small_needs;
     assert!(
-        held(&resident) > limit,
+        held_bytes(&resident) > limit,
         "the resident scene ({} B) must be past the limit ({limit} B) for the test to bind",
-        held(&resident)
+        held_bytes(&resident)
     );
     let with = |limit: u64| EmbreeParams {
         memory_limit_bytes: Some(limit),
@@ -239,7 +241,7 @@ fn a_memory_limit_leaves_out_the_scenes_already_on_the_device() {
         }) => {
             assert_eq!(limit_bytes, small_needs / 4);
             assert!(
-                reached_bytes > limit_bytes && reached_bytes < held(&resident),
+                reached_bytes > limit_bytes && reached_bytes < held_bytes(&resident),
                 "refused at {reached_bytes} B: the build's own bytes, not the device's"
             );
         }
