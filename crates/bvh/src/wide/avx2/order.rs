@@ -9,6 +9,12 @@
 //! So the order is the insertion's — nearest first, equal distances lower slot first — except
 //! that distances within 8 (16) ulps of each other also count as equal. The stack keeps each
 //! child's exact distance, so the pops skip exactly what they skip after the insertion.
+//!
+//! The walk goes on with the nearest child alone; the others wait on the stack. So the nearest
+//! is taken by a reduction of the keys to their minimum (three steps on eight keys, four on
+//! sixteen) beside the network (six and ten stages): the next node's test waits for the
+//! reduction only, and the network and the pushes run beside it (measured: see
+//! docs/experiments.md, "the nearest child by a reduction beside the network").
 
 use crate::node::ChildRef;
 use crate::wide::walk::Stack;
@@ -66,6 +72,7 @@ pub(super) fn nearest_first_sorted<const W: usize>(
         lane_bits,
     );
     let keys = _mm256_blendv_epi8(_mm256_set1_epi32(-1), keys, entered);
+    let nearest = min8(keys);
     let mut sorted = [0u32; 8];
     // SAFETY: `sorted` is 8 writable u32s; `storeu` has no alignment requirement.
     unsafe { _mm256_storeu_si256(sorted.as_mut_ptr().cast(), sort8(keys)) };
@@ -75,12 +82,23 @@ pub(super) fn nearest_first_sorted<const W: usize>(
         entry,
         stack,
         sp,
-    )
+    );
+    child[(nearest & 7) as usize]
+}
+
+/// The smallest of eight keys, in three steps.
+#[target_feature(enable = "avx2")]
+#[inline]
+fn min8(k: __m256i) -> u32 {
+    let k = _mm256_min_epu32(k, _mm256_permute2x128_si256::<1>(k, k));
+    let k = _mm256_min_epu32(k, _mm256_shuffle_epi32::<0b01_00_11_10>(k));
+    let k = _mm256_min_epu32(k, _mm256_shuffle_epi32::<0b10_11_00_01>(k));
+    _mm256_cvtsi256_si32(k) as u32
 }
 
 /// The children of the sorted keys `sorted` (the entered ones, nearest first; the slot in the
 /// low bits, below `W`, a power of two): pushes all but the first so that they pop nearest
-/// first, and returns the first.
+/// first. The first, which the walk takes next, the callers find by a reduction of their own.
 #[inline(always)]
 fn push_sorted<const W: usize>(
     sorted: &[u32],
@@ -88,14 +106,13 @@ fn push_sorted<const W: usize>(
     entry: &[f32; W],
     stack: &mut Stack,
     sp: &mut usize,
-) -> ChildRef {
+) {
     let slot_bits = (W - 1) as u32;
     for &key in sorted[1..].iter().rev() {
         let slot = (key & slot_bits) as usize;
         stack[*sp] = (child[slot], entry[slot]);
         *sp += 1;
     }
-    child[(sorted[0] & slot_bits) as usize]
 }
 
 /// One compare-exchange stage on sixteen keys: lane `i` meets lane `perm[i]`, and the lanes set
@@ -148,6 +165,7 @@ pub(super) fn nearest_first_sorted16<const W: usize>(
     let slots = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     let keys = _mm512_or_si512(_mm512_andnot_si512(_mm512_set1_epi32(15), bits), slots);
     let keys = _mm512_mask_mov_epi32(_mm512_set1_epi32(-1), mask as __mmask16, keys);
+    let nearest = _mm512_reduce_min_epu32(keys);
     let mut sorted = [0u32; 16];
     // SAFETY: `sorted` is 16 writable u32s; `storeu` has no alignment requirement.
     unsafe { _mm512_storeu_si512(sorted.as_mut_ptr().cast(), sort16(keys)) };
@@ -157,7 +175,8 @@ pub(super) fn nearest_first_sorted16<const W: usize>(
         entry,
         stack,
         sp,
-    )
+    );
+    child[(nearest & 15) as usize]
 }
 
 #[cfg(test)]
