@@ -14,7 +14,7 @@
 //! is taken by a reduction of the keys to their minimum (three steps on eight keys, four on
 //! sixteen) beside the network (six and ten stages): the next node's test waits for the
 //! reduction only, and the network and the pushes run beside it (measured: see
-//! docs/experiments.md, "the nearest child by a reduction beside the network").
+//! docs/experiments.md, "the nearest of four or more entered children taken by a reduction").
 
 use crate::node::ChildRef;
 use crate::wide::walk::Stack;
