@@ -1,8 +1,8 @@
-//! Times the wide BVHs (4 and 8 children) next to embree-medium on one scene, outside the harness, for quick
-//! before/after checks of traversal changes on a shared, noisy machine: each round times every
-//! structure once per workload, interleaved, and the figures printed are each structure's best
-//! pass (the one least disturbed by other processes) and its ratio to Embree's best pass.
-//! Short passes and many rounds make an undisturbed pass likely.
+//! Times the wide BVHs (4, 8 and 16 children) next to embree-medium on one scene, outside the
+//! harness, for quick before/after checks of traversal changes on a shared, noisy machine: each
+//! round times every structure once per workload, interleaved, and the figures printed are each
+//! structure's best pass (the one least disturbed by other processes) and its ratio to Embree's
+//! best pass. Short passes and many rounds make an undisturbed pass likely.
 //!
 //! `cargo run --release -p raybench-harness --example wide -- ../shared/scenes/stanford-bunny.obj 50000 20`
 //! (scene: an .obj path or a generator spec such as `hair`; rays per workload; rounds;
@@ -16,13 +16,16 @@
 //! every packet as one; `RB_FLOORS=8:2,6:3` adds `bvh8-packets` with other `node:tri4` floors,
 //! labelled `floors-8:2` and so on (name them in `RB_ONLY` too when it is set).
 //!
+//! `bvh16-sbvh` and `bvh16-sbvh-packets` are built with the registry's parameters of those
+//! entries.
+//!
 //! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
 //! CPU without AVX-512 the two are the same code. `RB_ONLY=embree-medium,bvh8` keeps only the
 //! structures named, for profiling one structure alone; ratios are then to the first one kept
 //! (embree-medium whenever it is kept).
 
 use raybench_accel::{Accel, PreparedRays};
-use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, NodeSimd, PacketFloors, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh16, BvhParams, NodeSimd, PacketFloors, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
 use raybench_scenes::{RayRecipe, SurfaceHit, Workload};
@@ -110,6 +113,22 @@ fn main() {
             Box::new(Bvh8::build(Arc::clone(&mesh), &f).expect("builds"))
         });
     }
+    add("bvh16-sbvh", &|| {
+        let p = WideParams {
+            width: 16,
+            ..WideParams::sbvh()
+        };
+        Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
+    });
+    add("bvh16-sbvh-packets", &|| {
+        let p = WideParams {
+            width: 16,
+            coherent_packets: true,
+            packet_floors: PacketFloors::MEASURED,
+            ..WideParams::sbvh()
+        };
+        Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
+    });
     let sse = WideParams {
         node_simd: NodeSimd::Sse,
         ..WideParams::default()
