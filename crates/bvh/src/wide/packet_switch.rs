@@ -22,11 +22,17 @@ pub(super) fn each_packet<const LANES: usize, const W: usize, T>(
     mut packet: impl FnMut(&RayBlock, &mut [T], &mut Usage),
 ) {
     let mut switch = Switch::new(bvh, first, LANES);
-    for ((block, out), rays) in blocks
+    for (i, ((block, out), rays)) in blocks
         .iter()
         .zip(out.chunks_mut(PACKET))
         .zip(rays.chunks(PACKET))
+        .enumerate()
     {
+        // The block two packets on, fetched while this one is walked: a packet reads its 512
+        // bytes at once, and the hardware's stream prefetch, which stops at every 4 KiB page
+        // (eight blocks), left camera-ray packets waiting on them (measured: see
+        // docs/experiments.md, "each packet's ray block fetched two packets ahead").
+        raybench_geom::prefetch(blocks.as_ptr().wrapping_add(i + 2));
         if let Some(k) = switch.ray_by_ray() {
             single(k, rays, out);
             continue;
