@@ -111,6 +111,28 @@ impl RayPackets {
     }
 }
 
+/// The blocks of a coherent batch in order, each with its rays and its outputs (fewer than
+/// [`PACKET`] in the batch's last block), every block fetched two blocks before it is yielded:
+/// a packet reads its whole block at once, and the hardware's stream prefetch stops at every
+/// 4 KiB page (eight blocks), which left camera-ray packets waiting on their rays (measured:
+/// see docs/experiments.md, "each packet's ray block fetched two packets ahead").
+#[inline(always)]
+pub fn each_block<'a, T>(
+    blocks: &'a [RayBlock],
+    rays: &'a [Ray],
+    out: &'a mut [T],
+) -> impl Iterator<Item = (&'a RayBlock, &'a [Ray], &'a mut [T])> {
+    blocks
+        .iter()
+        .enumerate()
+        .zip(rays.chunks(PACKET))
+        .zip(out.chunks_mut(PACKET))
+        .map(move |(((i, block), rays), out)| {
+            crate::prefetch(blocks.as_ptr().wrapping_add(i + 2));
+            (block, rays, out)
+        })
+}
+
 /// A block loaded into a packet, with its closest-hit windows' far ends as the best hits so
 /// far.
 ///
@@ -520,6 +542,44 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// [`each_block`] yields every block once, in order, with its own rays and outputs: a whole
+    /// block sixteen of each, the last block of a batch that does not fill it only the rest.
+    #[test]
+    fn each_block_pairs_blocks_with_their_rays_and_outputs() {
+        for len in [1, PACKET - 1, PACKET, PACKET + 1, 5 * PACKET + 3] {
+            let rays: Vec<Ray> = (0..len)
+                .map(|i| Ray::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::Z, 0.0, 1.0))
+                .collect();
+            let packets = RayPackets::new(&rays);
+            let blocks = packets.range(0, len).expect("the whole batch");
+            let mut out = vec![usize::MAX; len];
+            let mut yielded = 0;
+            for (b, (block, block_rays, block_out)) in
+                each_block(blocks, &rays, &mut out).enumerate()
+            {
+                assert!(std::ptr::eq(block, &blocks[b]), "len {len}: block {b}");
+                let want = PACKET.min(len - PACKET * b);
+                assert_eq!(
+                    (block_rays.len(), block_out.len()),
+                    (want, want),
+                    "len {len}"
+                );
+                for (lane, (ray, o)) in block_rays.iter().zip(block_out.iter_mut()).enumerate() {
+                    // Each ray is its block's row 0 lane: the block was made from these rays.
+                    assert_eq!(
+                        ray.origin().x,
+                        block.rows()[0][lane],
+                        "len {len}: block {b}"
+                    );
+                    *o = ray.origin().x as usize;
+                }
+                yielded += 1;
+            }
+            assert_eq!(yielded, blocks.len(), "len {len}");
+            assert_eq!(out, (0..len).collect::<Vec<_>>(), "len {len}");
         }
     }
 }

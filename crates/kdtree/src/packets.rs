@@ -68,11 +68,7 @@ fn intersect_packets(
     out: &mut [Option<Hit>],
     stack: &mut PacketStack,
 ) {
-    for ((block, out), rays) in blocks
-        .iter()
-        .zip(out.chunks_mut(PACKET))
-        .zip(rays.chunks(PACKET))
-    {
+    for (block, rays, out) in packet::each_block(blocks, rays, out) {
         let (p, mut best) = packet::load(block);
         walk_packet::<false>(kd, &p, rays, out.len(), &mut best, stack);
         for (o, (prim, h)) in out.iter_mut().zip(best.hits()) {
@@ -103,11 +99,7 @@ fn occluded_packets(
     out: &mut [bool],
     stack: &mut PacketStack,
 ) {
-    for ((block, out), rays) in blocks
-        .iter()
-        .zip(out.chunks_mut(PACKET))
-        .zip(rays.chunks(PACKET))
-    {
+    for (block, rays, out) in packet::each_block(blocks, rays, out) {
         let (p, mut best) = packet::load(block);
         let done = walk_packet::<true>(kd, &p, rays, out.len(), &mut best, stack);
         for (lane, o) in out.iter_mut().enumerate() {

@@ -10,7 +10,7 @@
 use crate::KdTree;
 use crate::node::MAX_DEPTH;
 use raybench_accel::Hit;
-use raybench_geom::packet::{PACKET, RayBlock};
+use raybench_geom::packet::{RayBlock, each_block};
 use raybench_geom::packet8::{self, Avx2Packets, Best8, LANES, Packet8, bits};
 use raybench_geom::{NO_PRIM, Ray};
 use std::arch::x86_64::*;
@@ -100,11 +100,7 @@ fn each_packet<T>(
     out: &mut [T],
     mut packet: impl FnMut(&RayBlock, usize, &[Ray], &mut [T]),
 ) {
-    for ((block, out), rays) in blocks
-        .iter()
-        .zip(out.chunks_mut(PACKET))
-        .zip(rays.chunks(PACKET))
-    {
+    for (block, rays, out) in each_block(blocks, rays, out) {
         for (half, (out, rays)) in out.chunks_mut(LANES).zip(rays.chunks(LANES)).enumerate() {
             packet(block, half, rays, out);
         }

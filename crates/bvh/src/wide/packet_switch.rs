@@ -6,7 +6,7 @@
 use super::avx2;
 use crate::wide::BvhWide;
 use raybench_geom::Ray;
-use raybench_geom::packet::{PACKET, RayBlock};
+use raybench_geom::packet::{PACKET, RayBlock, each_block};
 
 /// Traces `blocks` (the packets of `rays`, the batch from ray `first` on) into `out`, a
 /// block at a time: ray by ray through `single` where the [`Switch`] says so, else through
@@ -22,17 +22,7 @@ pub(super) fn each_packet<const LANES: usize, const W: usize, T>(
     mut packet: impl FnMut(&RayBlock, &mut [T], &mut Usage),
 ) {
     let mut switch = Switch::new(bvh, first, LANES);
-    for (i, ((block, out), rays)) in blocks
-        .iter()
-        .zip(out.chunks_mut(PACKET))
-        .zip(rays.chunks(PACKET))
-        .enumerate()
-    {
-        // The block two packets on, fetched while this one is walked: a packet reads its 512
-        // bytes at once, and the hardware's stream prefetch, which stops at every 4 KiB page
-        // (eight blocks), left camera-ray packets waiting on them (measured: see
-        // docs/experiments.md, "each packet's ray block fetched two packets ahead").
-        raybench_geom::prefetch(blocks.as_ptr().wrapping_add(i + 2));
+    for (block, rays, out) in each_block(blocks, rays, out) {
         if let Some(k) = switch.ray_by_ray() {
             single(k, rays, out);
             continue;
