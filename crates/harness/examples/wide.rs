@@ -16,8 +16,7 @@
 //! every packet as one; `RB_FLOORS=8:2,6:3` adds `bvh8-packets` with other `node:tri4` floors,
 //! labelled `floors-8:2` and so on (name them in `RB_ONLY` too when it is set).
 //!
-//! `bvh16-sbvh` and `bvh16-sbvh-packets` are built with the registry's parameters of those
-//! entries.
+//! `bvh16-sbvh` and `bvh16-sbvh-packets` are the registry's entries, built through it.
 //!
 //! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
 //! CPU without AVX-512 the two are the same code. `RB_ONLY=embree-medium,bvh8` keeps only the
@@ -25,9 +24,11 @@
 //! (embree-medium whenever it is kept).
 
 use raybench_accel::{Accel, PreparedRays};
-use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh16, BvhParams, NodeSimd, PacketFloors, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, NodeSimd, PacketFloors, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
+use raybench_harness::Registry;
+use raybench_harness::registry::BuildContext;
 use raybench_scenes::{RayRecipe, SurfaceHit, Workload};
 use std::sync::Arc;
 use std::time::Instant;
@@ -113,22 +114,17 @@ fn main() {
             Box::new(Bvh8::build(Arc::clone(&mesh), &f).expect("builds"))
         });
     }
-    add("bvh16-sbvh", &|| {
-        let p = WideParams {
-            width: 16,
-            ..WideParams::sbvh()
-        };
-        Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
-    });
-    add("bvh16-sbvh-packets", &|| {
-        let p = WideParams {
-            width: 16,
-            coherent_packets: true,
-            packet_floors: PacketFloors::MEASURED,
-            ..WideParams::sbvh()
-        };
-        Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
-    });
+    // The 16-wide entries as registered, built through the registry so they cannot drift from it.
+    for e in Registry::builtin()
+        .select(&["bvh16-sbvh".to_string(), "bvh16-sbvh-packets".to_string()])
+        .expect("registered")
+    {
+        add(e.name, &|| {
+            e.build(Arc::clone(&mesh), &BuildContext::new(1))
+                .expect("builds")
+                .accel
+        });
+    }
     let sse = WideParams {
         node_simd: NodeSimd::Sse,
         ..WideParams::default()
