@@ -124,11 +124,10 @@ pub fn each_block<'a, T>(
 ) -> impl Iterator<Item = (&'a RayBlock, &'a [Ray], &'a mut [T])> {
     blocks
         .iter()
-        .enumerate()
         .zip(rays.chunks(PACKET))
         .zip(out.chunks_mut(PACKET))
-        .map(move |(((i, block), rays), out)| {
-            crate::prefetch(blocks.as_ptr().wrapping_add(i + 2));
+        .map(|((block, rays), out)| {
+            crate::prefetch(std::ptr::from_ref(block).wrapping_add(2));
             (block, rays, out)
         })
 }
