@@ -44,20 +44,20 @@ fn plan_grain(nodes: usize) -> usize {
     crate::grain::grain(nodes, MIN_PLAN_TASK, PARALLEL_PLAN)
 }
 
-/// One binary interior node's entry: for `i` = 1 to `W`, the least cost of covering it with
-/// at most `i` children (`cost[i - 1]`) and how (`cover[i - 1]`: `(0, 0)` the node alone, or
-/// at most that many children from each of its two); and how its own wide node splits its
-/// `W` slots between its children.
+/// One binary interior node's entry: for `i` = 1 to `W`, how to cover it with at most `i`
+/// children (`cover[i - 1]`: `(0, 0)` the node alone, or at most that many children from each
+/// of its two); and how its own wide node splits its `W` slots between its children. The
+/// costs behind these choices are needed only by the node's parent, so they travel up the
+/// recursion instead of living here: an entry of 18 bytes at 8 wide instead of 88, written once
+/// per binary node (measured: see docs/experiments.md, "the plan's costs returned, not stored").
 #[derive(Clone, Copy)]
 struct Entry<const W: usize> {
-    cost: [f64; W],
     cover: [(u8, u8); W],
     own: (u8, u8),
 }
 
 impl<const W: usize> Entry<W> {
     const EMPTY: Entry<W> = Entry {
-        cost: [0.0; W],
         cover: [(0, 0); W],
         own: (0, 0),
     };
@@ -122,87 +122,91 @@ impl<const W: usize> Plan<W> {
             );
         }
     }
-
-    /// The least cost of the wide tree made from binary interior node `r` (its own node
-    /// test included), in the builder's prices, not divided by the root's area.
-    #[cfg(test)]
-    pub(super) fn cost_as_node(&self, r: ChildRef) -> f64 {
-        self.entries[r.index as usize].cost[0]
-    }
 }
 
-/// Fills the entries of the subtree of binary interior node `at`: `entries` is exactly that
-/// subtree's range of the binary tree, so `entries[0]` is `at`'s entry.
+/// The least cost of the wide tree made from binary interior node `r` (its own node test
+/// included), in the builder's prices, not divided by the root's area: the plan of `r`'s
+/// subtree alone.
+#[cfg(test)]
+pub(super) fn cost_as_node<const W: usize>(nodes: &[Node], r: ChildRef, p: &BvhParams) -> f64 {
+    let at = r.index as usize;
+    plan::<W>(
+        nodes,
+        at,
+        &mut vec![Entry::EMPTY; nodes.len() - at],
+        p,
+        usize::MAX,
+    )[0]
+}
+
+/// Fills the entries of the subtree of binary interior node `at` and returns `at`'s costs: for
+/// `i` = 1 to `W`, the least cost of covering it with at most `i` children. `entries` starts
+/// with that subtree's range of the binary tree, so `entries[0]` is `at`'s entry.
 fn plan<const W: usize>(
     nodes: &[Node],
     at: usize,
     entries: &mut [Entry<W>],
     p: &BvhParams,
     grain: usize,
-) {
+) -> [f64; W] {
     let node = &nodes[at];
     // A child's subtree starts at its index; the left one right after `at`.
-    let (left, right) = (node.child[0], node.child[1]);
+    let right = node.child[1];
     let right_offset = if right.is_leaf() {
         entries.len()
     } else {
         right.index as usize - at
     };
-    {
-        let (left_part, right_part) = entries[1..].split_at_mut(right_offset - 1);
-        let big = left_part.len().min(right_part.len()) >= grain;
-        let go_left = |part: &mut [Entry<W>]| {
-            if !left.is_leaf() {
-                plan(nodes, left.index as usize, part, p, grain);
-            }
-        };
-        let go_right = |part: &mut [Entry<W>]| {
-            if !right.is_leaf() {
-                plan(nodes, right.index as usize, part, p, grain);
-            }
-        };
-        if big {
-            rayon::join(|| go_left(left_part), || go_right(right_part));
-        } else {
-            go_left(left_part);
-            go_right(right_part);
-        }
-    }
-    let side = |c: usize| -> [f64; W] {
+    let side = |c: usize, part: &mut [Entry<W>]| -> [f64; W] {
         let r = node.child[c];
         if r.is_leaf() {
             [leaf_cost(node.child_bounds(c).surface_area(), r.count, p); W]
         } else {
-            entries[r.index as usize - at].cost
+            plan(nodes, r.index as usize, part, p, grain)
         }
     };
-    let (l, r) = (side(0), side(1));
-    // The cheapest split of `j` slots between the two children, j = 2 ..= width.
-    // Starting from one slot on the left, so every split names both children's slots.
-    let mut split = [(0.0, (0u8, 0u8)); MAX_WIDTH + 1];
-    for (j, s) in split.iter_mut().enumerate().take(W + 1).skip(2) {
-        *s = (l[0] + r[j - 2], (1, (j - 1) as u8));
-        for k in 2..j {
+    let (l, r) = {
+        let (left_part, right_part) = entries[1..].split_at_mut(right_offset - 1);
+        if left_part.len().min(right_part.len()) >= grain {
+            rayon::join(|| side(0, left_part), || side(1, right_part))
+        } else {
+            (side(0, left_part), side(1, right_part))
+        }
+    };
+    // The cheapest split of `j` slots between the two children, j = 2 ..= width: `k` slots on
+    // the left, the first `k` of equal costs. Looping over `k` outside and `j` inside gives
+    // the same minima as the other way round (each `j` still meets `k` in increasing order)
+    // with an inner loop of independent lanes.
+    let mut cost = [0.0; MAX_WIDTH + 1];
+    let mut left_slots = [1u8; MAX_WIDTH + 1];
+    for j in 2..=W {
+        cost[j] = l[0] + r[j - 2];
+    }
+    for k in 2..W {
+        for j in k + 1..=W {
             let c = l[k - 1] + r[j - k - 1];
-            if c < s.0 {
-                *s = (c, (k as u8, (j - k) as u8));
-            }
+            let better = c < cost[j];
+            cost[j] = if better { c } else { cost[j] };
+            left_slots[j] = if better { k as u8 } else { left_slots[j] };
         }
     }
+    let split = |j: usize| (left_slots[j], j as u8 - left_slots[j]);
     let area = node
         .child_bounds(0)
         .union(&node.child_bounds(1))
         .surface_area();
     let e = &mut entries[0];
-    e.own = split[W].1;
-    let mut best = (area * p.traversal_cost as f64 + split[W].0, (0, 0));
-    for (i, s) in split.iter().enumerate().take(W + 1).skip(1) {
-        if i >= 2 && s.0 < best.0 {
-            best = *s;
+    e.own = split(W);
+    let mut costs = [0.0; W];
+    let mut best = (area * p.traversal_cost as f64 + cost[W], (0, 0));
+    for i in 1..=W {
+        if i >= 2 && cost[i] < best.0 {
+            best = (cost[i], split(i));
         }
-        e.cost[i - 1] = best.0;
+        costs[i - 1] = best.0;
         e.cover[i - 1] = best.1;
     }
+    costs
 }
 
 fn leaf_cost(area: f64, n: u32, p: &BvhParams) -> f64 {
@@ -306,14 +310,15 @@ mod tests {
         ] {
             let flat = binary(spec, &p);
             assert!(flat.nodes.len() > 20, "{spec}: {} nodes", flat.nodes.len());
-            let plan = Plan::<WIDTH>::new(&flat.nodes, &p);
             for i in 0..flat.nodes.len().min(60) {
                 let r = ChildRef {
                     index: i as u32,
                     count: 0,
                 };
-                let (planned, exhaustive) =
-                    (plan.cost_as_node(r), cheapest_node(&flat.nodes, r, &p));
+                let (planned, exhaustive) = (
+                    cost_as_node::<WIDTH>(&flat.nodes, r, &p),
+                    cheapest_node(&flat.nodes, r, &p),
+                );
                 assert!(
                     close(planned, exhaustive),
                     "{spec} node {i}: {planned} against {exhaustive}"
@@ -340,7 +345,7 @@ mod tests {
             optimal.validate(&mesh).expect("the tree validates");
             let p = &optimal.params().binary;
             let flat = build(&mesh, p).expect("builds");
-            let planned = Plan::<W>::new(&flat.nodes, p).cost_as_node(flat.root);
+            let planned = cost_as_node::<W>(&flat.nodes, flat.root, p);
             let (built, greedy) = (wide_cost(&optimal, p), wide_cost(&greedy, p));
             assert!(
                 close(planned, built),
@@ -389,7 +394,6 @@ mod tests {
         let (one, two) = (plan(1), plan(2));
         assert_eq!(one.entries.len(), two.entries.len());
         for (a, b) in one.entries.iter().zip(&two.entries) {
-            assert_eq!(a.cost.map(f64::to_bits), b.cost.map(f64::to_bits));
             assert_eq!((a.cover, a.own), (b.cover, b.own));
         }
     }
