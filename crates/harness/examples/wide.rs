@@ -16,7 +16,9 @@
 //! every packet as one; `RB_FLOORS=8:2,6:3` adds `bvh8-packets` with other `node:tri4` floors,
 //! labelled `floors-8:2` and so on (name them in `RB_ONLY` too when it is set).
 //!
-//! `bvh16-sbvh` and `bvh16-sbvh-packets` are the registry's entries, built through it.
+//! `bvh16-sbvh` and `bvh16-sbvh-packets` are the registry's entries, built through it;
+//! `RB_REGISTRY=bvh8-sbvh,bvh16-binned` adds other registry entries by name; `RB_SPATIAL=0.2`
+//! adds `bvh16-sbvh` with another price of a triangle test in the spatial splits' choices.
 //!
 //! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
 //! CPU without AVX-512 the two are the same code. `RB_ONLY=embree-medium,bvh8` keeps only the
@@ -24,7 +26,7 @@
 //! (embree-medium whenever it is kept).
 
 use raybench_accel::{Accel, PreparedRays};
-use raybench_bvh::{Bvh, Bvh4, Bvh8, BvhParams, NodeSimd, PacketFloors, WideParams};
+use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh16, BvhParams, NodeSimd, PacketFloors, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
 use raybench_harness::Registry;
@@ -115,14 +117,33 @@ fn main() {
         });
     }
     // The 16-wide entries as registered, built through the registry so they cannot drift from it.
-    for e in Registry::builtin()
-        .select(&["bvh16-sbvh".to_string(), "bvh16-sbvh-packets".to_string()])
-        .expect("registered")
-    {
+    // `RB_REGISTRY=bvh8-sbvh,bvh16-binned` adds more registry entries by name.
+    let mut names = vec!["bvh16-sbvh".to_string(), "bvh16-sbvh-packets".to_string()];
+    if let Ok(more) = std::env::var("RB_REGISTRY") {
+        names.extend(more.split(',').filter(|n| !n.is_empty()).map(String::from));
+    }
+    for e in Registry::builtin().select(&names).expect("registered") {
         add(e.name, &|| {
             e.build(Arc::clone(&mesh), &BuildContext::new(1))
                 .expect("builds")
                 .accel
+        });
+    }
+    // `RB_SPATIAL=0.2,0.15`: `bvh16-sbvh` again with each price of a triangle test in the
+    // spatial splits' choices, labelled `sbvh16-0.2` and so on.
+    for cost in std::env::var("RB_SPATIAL").unwrap_or_default().split(',') {
+        let Ok(cost) = cost.parse::<f32>() else {
+            continue;
+        };
+        add(&format!("sbvh16-{cost}"), &|| {
+            let mut p = WideParams {
+                width: 16,
+                ..WideParams::sbvh()
+            };
+            if let Some(s) = p.binary.spatial_splits.as_mut() {
+                s.intersection_cost = cost;
+            }
+            Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
         });
     }
     let sse = WideParams {
