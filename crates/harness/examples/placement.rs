@@ -18,6 +18,9 @@ use raybench_scenes::{RayRecipe, SurfaceHit, Workload};
 use std::sync::Arc;
 use std::time::Instant;
 
+mod probe;
+use probe::median;
+
 /// Millions of camera rays a second of one pass.
 fn mrays(accel: &dyn Accel, rays: &[Ray], prepared: &PreparedRays, out: &mut [Option<Hit>]) -> f64 {
     let start = Instant::now();
@@ -76,9 +79,7 @@ fn main() {
         }
         best_embree = best_embree.max(mrays(&embree, &rays, &embree_rays, &mut out));
     }
-    let mut sorted = best.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[copies / 2];
+    let median = median(best.clone());
     for (k, rate) in best.iter().enumerate() {
         println!(
             "copy {k:3} {rate:7.2} Mrays/s  {:.3}x embree",
