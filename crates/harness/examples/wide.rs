@@ -2,7 +2,8 @@
 //! harness, for quick before/after checks of traversal changes on a shared, noisy machine: each
 //! round times every structure once per workload, interleaved, and the figures printed are each
 //! structure's best pass (the one least disturbed by other processes) and its ratio to Embree's
-//! best pass. Short passes and many rounds make an undisturbed pass likely.
+//! best pass. Short passes and many rounds make an undisturbed pass likely. Every pass writes
+//! its answers into arrays made before the rounds, so none pays for an allocation.
 //!
 //! `cargo run --release -p raybench-harness --example wide -- ../shared/scenes/stanford-bunny.obj 50000 20`
 //! (scene: an .obj path or a generator spec such as `hair`; rays per workload; rounds;
@@ -21,11 +22,12 @@
 //! adds `bvh16-sbvh` with another price of a triangle test in the spatial splits' choices.
 //!
 //! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
-//! CPU without AVX-512 the two are the same code. `RB_ONLY=embree-medium,bvh8` keeps only the
+//! CPU without AVX-512 the two are the same code. `bvh16-sbvh-packets-avx2` and
+//! `bvh8-packets-avx2` likewise: their packets are the eight-lane walk of CPUs without AVX-512F. `RB_ONLY=embree-medium,bvh8` keeps only the
 //! structures named, for profiling one structure alone; ratios are then to the first one kept
 //! (embree-medium whenever it is kept).
 
-use raybench_accel::{Accel, PreparedRays};
+use raybench_accel::{Accel, Hit, PreparedRays};
 use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh16, BvhParams, NodeSimd, PacketFloors, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
@@ -35,17 +37,28 @@ use raybench_scenes::{RayRecipe, SurfaceHit, Workload};
 use std::sync::Arc;
 use std::time::Instant;
 
+/// Where a pass writes its answers: made once per workload, outside the timed passes, so no
+/// pass pays for a fresh allocation or its page faults (as in the harness's rounds).
+struct Answers {
+    hits: Vec<Option<Hit>>,
+    occluded: Vec<bool>,
+}
+
 /// Rays per second of one pass (closest hit, or any hit for shadow rays), in millions.
-fn mrays(accel: &dyn Accel, rays: &[Ray], prepared: &PreparedRays, any_hit: bool) -> f64 {
+fn mrays(
+    accel: &dyn Accel,
+    rays: &[Ray],
+    prepared: &PreparedRays,
+    any_hit: bool,
+    out: &mut Answers,
+) -> f64 {
     let start = Instant::now();
     if any_hit {
-        let mut out = vec![false; rays.len()];
-        accel.occluded_prepared(rays, prepared, 0, &mut out);
-        std::hint::black_box(&out);
+        accel.occluded_prepared(rays, prepared, 0, &mut out.occluded);
+        std::hint::black_box(&out.occluded);
     } else {
-        let mut out = vec![None; rays.len()];
-        accel.intersect_prepared(rays, prepared, 0, &mut out);
-        std::hint::black_box(&out);
+        accel.intersect_prepared(rays, prepared, 0, &mut out.hits);
+        std::hint::black_box(&out.hits);
     }
     rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6
 }
@@ -154,6 +167,25 @@ fn main() {
         node_simd: NodeSimd::Avx2,
         ..WideParams::default()
     };
+    // `bvh16-sbvh-packets` and `bvh8-packets` with every walk compiled for AVX2 alone: packets
+    // of eight rays a register, the 8-lane walk of CPUs without AVX-512F.
+    let packets_avx2 = |p: WideParams| WideParams {
+        coherent_packets: true,
+        packet_floors: PacketFloors::MEASURED,
+        node_simd: NodeSimd::Avx2,
+        ..p
+    };
+    add("bvh16-sbvh-packets-avx2", &|| {
+        let p = packets_avx2(WideParams {
+            width: 16,
+            ..WideParams::sbvh()
+        });
+        Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
+    });
+    add("bvh8-packets-avx2", &|| {
+        let p = packets_avx2(WideParams::default());
+        Box::new(Bvh8::build(Arc::clone(&mesh), &p).expect("builds"))
+    });
     add("bvh8-avx2", &|| {
         Box::new(Bvh8::build(Arc::clone(&mesh), &only_avx2).expect("builds"))
     });
@@ -200,10 +232,20 @@ fn main() {
                 }
             })
             .collect();
+        let mut out = Answers {
+            hits: vec![None; rays.len()],
+            occluded: vec![false; rays.len()],
+        };
         let mut rates = vec![Vec::new(); structures.len()];
         for _ in 0..rounds + 1 {
             for (k, (_, accel, _)) in structures.iter().enumerate() {
-                rates[k].push(mrays(accel.as_ref(), rays, &prepared[k], *any_hit));
+                rates[k].push(mrays(
+                    accel.as_ref(),
+                    rays,
+                    &prepared[k],
+                    *any_hit,
+                    &mut out,
+                ));
             }
         }
         for r in &mut rates {
