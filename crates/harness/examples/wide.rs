@@ -19,7 +19,9 @@
 //!
 //! `bvh16-sbvh` and `bvh16-sbvh-packets` are the registry's entries, built through it;
 //! `RB_REGISTRY=bvh8-sbvh,bvh16-binned` adds other registry entries by name; `RB_SPATIAL=0.2`
-//! adds `bvh16-sbvh` with another price of a triangle test in the spatial splits' choices.
+//! adds `bvh16-sbvh` with another price of a triangle test in the spatial splits' choices;
+//! `RB_TRI=0.2` adds both 16-wide trees with another price of a triangle slot against a node
+//! step (`sbvh16-tri0.2`, `bin16-tri0.2`).
 //!
 //! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
 //! CPU without AVX-512 the two are the same code. `bvh16-sbvh-packets-avx2` and
@@ -158,6 +160,27 @@ fn main() {
             }
             Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
         });
+    }
+    // `RB_TRI=0.2,0.25`: `bvh16-sbvh` and `bvh16-binned` again with another price of a
+    // triangle slot against a node step (the binary build's and the collapse's
+    // `intersection_cost`), labelled `sbvh16-tri0.2`, `bin16-tri0.2` and so on.
+    for cost in std::env::var("RB_TRI").unwrap_or_default().split(',') {
+        let Ok(cost) = cost.parse::<f32>() else {
+            continue;
+        };
+        for (label, base) in [
+            ("sbvh16", WideParams::sbvh()),
+            ("bin16", WideParams::default()),
+        ] {
+            add(&format!("{label}-tri{cost}"), &|| {
+                let mut p = WideParams {
+                    width: 16,
+                    ..base.clone()
+                };
+                p.binary.intersection_cost = cost;
+                Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
+            });
+        }
     }
     let sse = WideParams {
         node_simd: NodeSimd::Sse,
