@@ -24,8 +24,9 @@
 //! step (`sbvh16-tri0.2`, `bin16-tri0.2`).
 //!
 //! `bvh8-avx2` is `bvh8` with its batch loops compiled for AVX2 alone (`NodeSimd::Avx2`); on a
-//! CPU without AVX-512 the two are the same code. `bvh16-sbvh-packets-avx2` and
-//! `bvh8-packets-avx2` likewise: their packets are the eight-lane walk of CPUs without AVX-512F. `RB_ONLY=embree-medium,bvh8` keeps only the
+//! CPU without AVX-512 the two are the same code. `RB_PACKETS_AVX2=1` adds
+//! `bvh16-sbvh-packets-avx2` and `bvh8-packets-avx2`, held to AVX2 likewise: their packets are
+//! the eight-lane walk of CPUs without AVX-512F. `RB_ONLY=embree-medium,bvh8` keeps only the
 //! structures named, for profiling one structure alone; ratios are then to the first one kept
 //! (embree-medium whenever it is kept).
 
@@ -190,25 +191,27 @@ fn main() {
         node_simd: NodeSimd::Avx2,
         ..WideParams::default()
     };
-    // `bvh16-sbvh-packets` and `bvh8-packets` with every walk compiled for AVX2 alone: packets
-    // of eight rays a register, the 8-lane walk of CPUs without AVX-512F.
-    let packets_avx2 = |p: WideParams| WideParams {
-        coherent_packets: true,
-        packet_floors: PacketFloors::MEASURED,
-        node_simd: NodeSimd::Avx2,
-        ..p
-    };
-    add("bvh16-sbvh-packets-avx2", &|| {
-        let p = packets_avx2(WideParams {
-            width: 16,
-            ..WideParams::sbvh()
+    // `RB_PACKETS_AVX2=1`: `bvh16-sbvh-packets` and `bvh8-packets` with every walk compiled for
+    // AVX2 alone: packets of eight rays a register, the 8-lane walk of CPUs without AVX-512F.
+    if std::env::var_os("RB_PACKETS_AVX2").is_some() {
+        let packets_avx2 = |p: WideParams| WideParams {
+            coherent_packets: true,
+            packet_floors: PacketFloors::MEASURED,
+            node_simd: NodeSimd::Avx2,
+            ..p
+        };
+        add("bvh16-sbvh-packets-avx2", &|| {
+            let p = packets_avx2(WideParams {
+                width: 16,
+                ..WideParams::sbvh()
+            });
+            Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
         });
-        Box::new(Bvh16::build(Arc::clone(&mesh), &p).expect("builds"))
-    });
-    add("bvh8-packets-avx2", &|| {
-        let p = packets_avx2(WideParams::default());
-        Box::new(Bvh8::build(Arc::clone(&mesh), &p).expect("builds"))
-    });
+        add("bvh8-packets-avx2", &|| {
+            let p = packets_avx2(WideParams::default());
+            Box::new(Bvh8::build(Arc::clone(&mesh), &p).expect("builds"))
+        });
+    }
     add("bvh8-avx2", &|| {
         Box::new(Bvh8::build(Arc::clone(&mesh), &only_avx2).expect("builds"))
     });
