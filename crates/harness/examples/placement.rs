@@ -9,24 +9,20 @@
 //! `cargo run --release -p raybench-harness --example placement -- teapot bvh16-sbvh 40`
 //! (scene: an .obj path or a generator spec; entry; copies; optionally rounds, 7 by default).
 
-use raybench_accel::{Accel, Hit, PreparedRays};
+use raybench_accel::{Accel, PreparedRays};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
 use raybench_harness::Registry;
 use raybench_harness::registry::BuildContext;
 use raybench_scenes::{RayRecipe, SurfaceHit, Workload};
 use std::sync::Arc;
-use std::time::Instant;
 
 mod probe;
-use probe::median;
+use probe::{Answers, median};
 
 /// Millions of camera rays a second of one pass.
-fn mrays(accel: &dyn Accel, rays: &[Ray], prepared: &PreparedRays, out: &mut [Option<Hit>]) -> f64 {
-    let start = Instant::now();
-    accel.intersect_prepared(rays, prepared, 0, out);
-    std::hint::black_box(&out);
-    rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6
+fn mrays(accel: &dyn Accel, rays: &[Ray], prepared: &PreparedRays, out: &mut Answers) -> f64 {
+    probe::prepared_pass(accel, rays, prepared, false, out)
 }
 
 fn main() {
@@ -70,7 +66,7 @@ fn main() {
         })
         .collect();
     let embree_rays = embree.prepare_coherent_rays(&rays).expect("valid rays");
-    let mut out = vec![None; rays.len()];
+    let mut out = Answers::for_rays(rays.len());
     let mut best = vec![0f64; copies];
     let mut best_embree = 0f64;
     for _ in 0..rounds {
@@ -101,7 +97,7 @@ fn main() {
         }
         let other_thread = std::thread::scope(|s| {
             s.spawn(|| {
-                let mut out = vec![None; rays.len()];
+                let mut out = Answers::for_rays(rays.len());
                 let mut r = [0f64; 2];
                 for _ in 0..rounds {
                     for (i, k) in [slow, good].into_iter().enumerate() {

@@ -30,7 +30,7 @@
 //! structures named, for profiling one structure alone; ratios are then to the first one kept
 //! (embree-medium whenever it is kept).
 
-use raybench_accel::{Accel, Hit, PreparedRays};
+use raybench_accel::{Accel, PreparedRays};
 use raybench_bvh::{Bvh, Bvh4, Bvh8, Bvh16, BvhParams, NodeSimd, PacketFloors, WideParams};
 use raybench_embree::{EmbreeParams, EmbreeScene};
 use raybench_geom::Ray;
@@ -40,30 +40,16 @@ use raybench_scenes::{RayRecipe, SurfaceHit, Workload};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Where a pass writes its answers: made once per workload, outside the timed passes, so no
-/// pass pays for a fresh allocation or its page faults (as in the harness's rounds).
-struct Answers {
-    hits: Vec<Option<Hit>>,
-    occluded: Vec<bool>,
-}
+mod probe;
+use probe::{Answers, prepared_pass};
 
-/// Rays per second of one pass (closest hit, or any hit for shadow rays), in millions.
-fn mrays(
-    accel: &dyn Accel,
-    rays: &[Ray],
-    prepared: &PreparedRays,
-    any_hit: bool,
-    out: &mut Answers,
-) -> f64 {
-    let start = Instant::now();
-    if any_hit {
-        accel.occluded_prepared(rays, prepared, 0, &mut out.occluded);
-        std::hint::black_box(&out.occluded);
-    } else {
-        accel.intersect_prepared(rays, prepared, 0, &mut out.hits);
-        std::hint::black_box(&out.hits);
-    }
-    rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6
+/// The prices listed in the variable `name` (`0.2,0.15`), skipping anything that is not a number.
+fn env_prices(name: &str) -> Vec<f32> {
+    std::env::var(name)
+        .unwrap_or_default()
+        .split(',')
+        .filter_map(|c| c.parse().ok())
+        .collect()
 }
 
 fn best(v: &[f64]) -> f64 {
@@ -147,10 +133,7 @@ fn main() {
     }
     // `RB_SPATIAL=0.2,0.15`: `bvh16-sbvh` again with each price of a triangle test in the
     // spatial splits' choices, labelled `sbvh16-0.2` and so on.
-    for cost in std::env::var("RB_SPATIAL").unwrap_or_default().split(',') {
-        let Ok(cost) = cost.parse::<f32>() else {
-            continue;
-        };
+    for cost in env_prices("RB_SPATIAL") {
         add(&format!("sbvh16-{cost}"), &|| {
             let mut p = WideParams {
                 width: 16,
@@ -165,10 +148,7 @@ fn main() {
     // `RB_TRI=0.2,0.25`: `bvh16-sbvh` and `bvh16-binned` again with another price of a
     // triangle slot against a node step (the binary build's and the collapse's
     // `intersection_cost`), labelled `sbvh16-tri0.2`, `bin16-tri0.2` and so on.
-    for cost in std::env::var("RB_TRI").unwrap_or_default().split(',') {
-        let Ok(cost) = cost.parse::<f32>() else {
-            continue;
-        };
+    for cost in env_prices("RB_TRI") {
         for (label, base) in [
             ("sbvh16", WideParams::sbvh()),
             ("bin16", WideParams::default()),
@@ -258,14 +238,11 @@ fn main() {
                 }
             })
             .collect();
-        let mut out = Answers {
-            hits: vec![None; rays.len()],
-            occluded: vec![false; rays.len()],
-        };
+        let mut out = Answers::for_rays(rays.len());
         let mut rates = vec![Vec::new(); structures.len()];
         for _ in 0..rounds + 1 {
             for (k, (_, accel, _)) in structures.iter().enumerate() {
-                rates[k].push(mrays(
+                rates[k].push(prepared_pass(
                     accel.as_ref(),
                     rays,
                     &prepared[k],

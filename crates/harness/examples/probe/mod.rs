@@ -1,8 +1,9 @@
 //! What the knob probes (`grid2tune`, `octtune`, `skiptune`; `trace_scaling` and `sbvh_tune`
 //! for their median and primary hits) share: a scene with its seeded random and primary rays,
-//! the primary rays' hits, a median, and a timed pass.
+//! the primary rays' hits, a median, and timed passes (`wide` and `placement` for the pass over
+//! prepared rays).
 
-use raybench_accel::{Accel, Counters};
+use raybench_accel::{Accel, Counters, Hit, PreparedRays};
 use raybench_geom::{Ray, TriangleMesh};
 use std::sync::Arc;
 use std::time::Instant;
@@ -58,4 +59,43 @@ pub fn time<A: Accel>(a: &A, rays: &[Ray], reps: usize) -> (f64, Counters) {
         a.intersect_counted(r, &mut c);
     }
     (rays.len() as f64 / median(times) / 1e6, c)
+}
+
+/// Where a pass over prepared rays writes its answers: made once, before the timed passes, so
+/// no pass pays for a fresh allocation or its page faults (as in the harness's rounds).
+#[allow(dead_code)]
+pub struct Answers {
+    pub hits: Vec<Option<Hit>>,
+    pub occluded: Vec<bool>,
+}
+
+#[allow(dead_code)]
+impl Answers {
+    pub fn for_rays(n: usize) -> Answers {
+        Answers {
+            hits: vec![None; n],
+            occluded: vec![false; n],
+        }
+    }
+}
+
+/// Mrays/s of one pass of `a` over `rays` as prepared (closest hit, or any hit), through the
+/// batch calls the harness times.
+#[allow(dead_code)]
+pub fn prepared_pass(
+    a: &dyn Accel,
+    rays: &[Ray],
+    prepared: &PreparedRays,
+    any_hit: bool,
+    out: &mut Answers,
+) -> f64 {
+    let start = Instant::now();
+    if any_hit {
+        a.occluded_prepared(rays, prepared, 0, &mut out.occluded[..rays.len()]);
+        std::hint::black_box(&out.occluded);
+    } else {
+        a.intersect_prepared(rays, prepared, 0, &mut out.hits[..rays.len()]);
+        std::hint::black_box(&out.hits);
+    }
+    rays.len() as f64 / start.elapsed().as_secs_f64() / 1e6
 }
