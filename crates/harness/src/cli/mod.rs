@@ -55,7 +55,8 @@ pub(crate) fn budget(text: &str) -> Result<u64, String> {
 /// What to run on: a suite and/or explicit scenes, structures, workloads, rays, seed, threads.
 #[derive(Args, Debug, Clone)]
 pub struct Selection {
-    /// A suite from bench-scenes/ (see `raybench list`); flags below override its settings.
+    /// A suite from bench-scenes/ (see `raybench list`), or a manifest file of your own (a
+    /// path ending in .json); flags below override its settings.
     #[arg(long)]
     pub suite: Option<String>,
     /// Scene specs (sphere, soup:triangles=5000) or .obj paths, comma-separated.
@@ -117,7 +118,7 @@ impl Selection {
     ) -> Result<Resolved> {
         let (suite, requests) = match &self.suite {
             Some(name) => {
-                let path = raybench_scenes::suites_dir().join(format!("{name}.json"));
+                let path = suite_path(name);
                 let suite = raybench_scenes::load_suite(&path)
                     .with_context(|| format!("suite '{name}'"))?;
                 let requests = if self.scenes.is_empty() {
@@ -224,6 +225,20 @@ pub fn join_spec_parameters(pieces: &[String]) -> Vec<String> {
         }
     }
     specs
+}
+
+/// The manifest `--suite` names: the file itself when the value ends in `.json` (relative to
+/// the working directory), else the suite of that name in [`raybench_scenes::suites_dir`].
+fn suite_path(name: &str) -> std::path::PathBuf {
+    let path = std::path::Path::new(name);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    {
+        path.to_owned()
+    } else {
+        raybench_scenes::suites_dir().join(format!("{name}.json"))
+    }
 }
 
 /// Explicit flags win, then the suite's value, then the default.

@@ -1,5 +1,6 @@
-//! Brute force's triangle limit in `run`: structures the user did not name (a suite's list, or
-//! every structure) skip it above 20,000 triangles with a note; named, it runs everywhere.
+//! Suites in `run`: brute force's triangle limit (structures the user did not name, a suite's
+//! list or every structure, skip it above 20,000 triangles with a note; named, it runs
+//! everywhere), and a suite given by its manifest's path instead of its name.
 
 use crate::common::{raybench, scratch};
 use raybench_harness::report::run::Report;
@@ -117,5 +118,56 @@ fn every_structure_by_default_skips_brute_force_past_its_limit() {
         "every other structure runs on the large scene"
     );
     assert_eq!(report.mismatches(), 0);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--suite` takes a manifest's path as well as a suite's name: a value ending in `.json` is the
+/// file itself (its OBJ paths relative to its own directory), whatever `RAYBENCH_SUITES` says;
+/// a missing one is an error naming that path, not a suite of `bench-scenes/`.
+#[test]
+fn a_suite_runs_from_a_manifest_path() {
+    let dir = scratch("suite-path");
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+    std::fs::write(dir.join("quad.obj"), obj).unwrap();
+    let manifest = dir.join("mine.json");
+    std::fs::write(
+        &manifest,
+        r#"{"name": "mine", "description": "a suite outside bench-scenes",
+            "scenes": ["teapot:triangles=500", {"obj": "quad.obj"}],
+            "structures": ["bvh8-binned"], "workloads": ["primary"], "rays": 200}"#,
+    )
+    .unwrap();
+    let mut run = raybench();
+    run.env("RAYBENCH_SUITES", dir.join("elsewhere"))
+        .args([
+            "run",
+            "--no-images",
+            "--build-runs",
+            "1",
+            "--trace-runs",
+            "1",
+        ])
+        .arg("--suite")
+        .arg(&manifest);
+    let report = report_of(run, &dir.join("out"));
+    let scenes: Vec<&str> = report.scenes.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(scenes.len(), 2, "{scenes:?}");
+    assert!(scenes[0].starts_with("teapot"), "{scenes:?}");
+    assert!(scenes[1].ends_with("quad.obj"), "{scenes:?}");
+
+    let missing = dir.join("absent.json");
+    let out = raybench()
+        .args(["run", "--no-images", "--suite"])
+        .arg(&missing)
+        .arg("--out")
+        .arg(dir.join("out2"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&*missing.to_string_lossy()) && !stderr.contains("absent.json.json"),
+        "{stderr}"
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
